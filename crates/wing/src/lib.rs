@@ -1,0 +1,6 @@
+//! # flapssm-wing — the flapping-wing domain
+//!
+//! Euler-angle kinematics of a wing, random wing trajectories, the virtual robotic wing
+//! (aerodynamics at three fidelities plus the experiment's sensor chain), quasi-steady
+//! features, aerodynamic coefficients and stroke cycles. Uses `flapssm-data` for files.
+#![warn(missing_docs)]
