@@ -18,7 +18,15 @@
 use serde::{Deserialize, Serialize};
 
 /// Names of the 7 inputs, in the published dataset's order.
-pub const INPUT_NAMES: [&str; 7] = ["aoa", "speed", "a_x", "a_y", "a_z", "pitch_rate", "pitch_acc"];
+pub const INPUT_NAMES: [&str; 7] = [
+    "aoa",
+    "speed",
+    "a_x",
+    "a_y",
+    "a_z",
+    "pitch_rate",
+    "pitch_acc",
+];
 /// Units of the 7 inputs.
 pub const INPUT_UNITS: [&str; 7] = ["rad", "1/s", "1/s^2", "1/s^2", "1/s^2", "rad/s", "rad/s^2"];
 /// Names of the 5 outputs.
@@ -46,7 +54,13 @@ pub struct WingGeometry {
 impl Default for WingGeometry {
     /// The wing of Bayiz & Cheng (2021): 0.18 m × 0.06 m, root offset 0.055 m, axis at 15 % chord.
     fn default() -> Self {
-        Self { span_m: 0.18, chord_m: 0.06, root_offset_m: 0.055, pitch_axis_frac: 0.15, u_ref_radius_m: 0.235 }
+        Self {
+            span_m: 0.18,
+            chord_m: 0.06,
+            root_offset_m: 0.055,
+            pitch_axis_frac: 0.15,
+            u_ref_radius_m: 0.235,
+        }
     }
 }
 
@@ -70,7 +84,10 @@ impl Default for Fluid {
     /// Mineral oil of the original experiment: ρ = 800 kg/m³, ν = 2.2e-5 m²/s (Re ≈ 1000 at
     /// U_ref ≈ 0.37 m/s, c̄ = 0.06 m).
     fn default() -> Self {
-        Self { density_kg_m3: 800.0, kinematic_viscosity_m2_s: 2.2e-5 }
+        Self {
+            density_kg_m3: 800.0,
+            kinematic_viscosity_m2_s: 2.2e-5,
+        }
     }
 }
 

@@ -7,11 +7,17 @@
 //!
 //! Modules:
 //! - [`dataset`]: the [`Dataset`] type, validation, split and standardization statistics.
+//! - [`npz`]: NumPy `.npy`/`.npz` reading and writing.
+//! - [`atomic`]: atomic file writes (temporary file + rename).
 //!
 //! Everything that writes a file writes a temporary file next to the target and renames it,
 //! so no half-written file is ever left behind.
 #![warn(missing_docs)]
 
+pub mod atomic;
 pub mod dataset;
+pub mod npz;
 
-pub use dataset::{Dataset, DatasetMeta, Fluid, Trajectory, WingGeometry, INPUT_NAMES, OUTPUT_NAMES};
+pub use dataset::{
+    Dataset, DatasetMeta, Fluid, INPUT_NAMES, OUTPUT_NAMES, Trajectory, WingGeometry,
+};
