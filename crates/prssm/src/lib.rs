@@ -11,3 +11,7 @@
 //! maximizing a particle-sampled ELBO with exact reverse-mode gradients. The engine knows
 //! nothing about wings: `D_u` inputs, `D_y` outputs, `D_x ≥ D_y` latent states.
 #![warn(missing_docs)]
+
+pub mod objective;
+
+pub use objective::{Objective, ObjectiveError, Window};
