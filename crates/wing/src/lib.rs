@@ -4,3 +4,5 @@
 //! (aerodynamics at three fidelities plus the experiment's sensor chain), quasi-steady
 //! features, aerodynamic coefficients and stroke cycles. Uses `flapssm-data` for files.
 #![warn(missing_docs)]
+
+pub mod features;
