@@ -1,6 +1,30 @@
 //! # flapssm-analysis — the paper's analyses, figures and report
 //!
-//! Accuracy metrics, standardized-error intervals, half-stroke cycle averages, latent-state
-//! cross-correlation ("control authority") with kernel density estimates, sweeps, figures and
-//! a self-contained HTML report.
+//! Built on plain arrays ([`stats::Rows`]: row-major `n_time × n_channels` slices), not on model
+//! types, so any model's predictions can be analysed.
+//!
+//! | module | what | published source |
+//! |---|---|---|
+//! | [`stats`] | MATLAB `prctile`/`median`/`iqr`, central intervals | — |
+//! | [`metrics`] | standardized errors, RMSE, overall score, histograms, load coefficients | `ferrorgpssm.m`, `plotter.m` |
+//! | [`cycles_avg`] | last-cycle windows, half-stroke averages and their errors | `fplotter.m` |
+//! | [`xcorr`] | MATLAB `crosscorr`, peak |r| within one cycle | `plotter.m` |
+//! | [`kde`] | 2-D reflected Gaussian KDE, mode, 70 % HDR, contours | `ksdensity` |
+//! | [`authority`] | control-authority analysis (Fig. 5 as data, JSON/CSV) | `plotter.m` |
+//! | [`plots`] | PNG/SVG figures (Figs. 2C, 3, 4, 5, training curves) | — |
+//! | [`report`] | one self-contained HTML page | — |
+//!
+//! Features: `parallel` (default) runs the per-trajectory cross-correlations on rayon.
 #![warn(missing_docs)]
+
+pub mod authority;
+pub mod cycles_avg;
+pub mod error;
+pub mod kde;
+pub mod metrics;
+pub mod plots;
+pub mod report;
+pub mod stats;
+pub mod xcorr;
+
+pub use error::{AnalysisError, Result};

@@ -7,6 +7,12 @@
 //!
 //! Modules:
 //! - [`dataset`]: the [`Dataset`] type, validation, split and standardization statistics.
+//! - [`store`]: the dataset file (one self-describing `.npz`), [`Dataset::save`]/[`Dataset::load`].
+//! - [`csv`]: long-format CSV export/import of a dataset.
+//! - [`mat`]: MATLAB Level 4 and Level 5 (incl. compressed) `.mat` readers.
+//! - [`published`]: import of the published Bayiz & Cheng dataset layout from a `.mat` file.
+//! - [`summary`]: a printable overview ([`Dataset::summary`]).
+//! - [`table`]: generic column tables from whitespace ASCII, CSV and MAT files.
 //! - [`npz`]: NumPy `.npy`/`.npz` reading and writing.
 //! - [`atomic`]: atomic file writes (temporary file + rename).
 //!
@@ -15,9 +21,17 @@
 #![warn(missing_docs)]
 
 pub mod atomic;
+pub mod csv;
 pub mod dataset;
+pub mod mat;
 pub mod npz;
+pub mod published;
+pub mod store;
+pub mod summary;
+pub mod table;
 
 pub use dataset::{
-    Dataset, DatasetMeta, Fluid, INPUT_NAMES, OUTPUT_NAMES, Trajectory, WingGeometry,
+    Dataset, DatasetError, DatasetMeta, EULER_NAMES, FORMAT_VERSION, Fluid, INPUT_NAMES,
+    INPUT_UNITS, OUTPUT_NAMES, OUTPUT_UNITS, Standardization, Trajectory, WingGeometry,
 };
+pub use store::StoreError;

@@ -463,15 +463,32 @@ fn npy_bytes(shape: &[usize], data: &NpyData) -> Vec<u8> {
 }
 
 /// Builds an `.npz` archive in memory, then writes it atomically.
-#[derive(Debug, Default)]
+#[derive(Debug)]
 pub struct NpzWriter {
     members: BTreeMap<String, (Vec<usize>, NpyData)>,
+    compress: bool,
+}
+
+impl Default for NpzWriter {
+    fn default() -> Self {
+        Self {
+            members: BTreeMap::new(),
+            compress: true,
+        }
+    }
 }
 
 impl NpzWriter {
-    /// An empty archive.
+    /// An empty archive (members deflate-compressed, like `np.savez_compressed`).
     pub fn new() -> Self {
         Self::default()
+    }
+
+    /// Chooses deflate compression (default) or stored members (like `np.savez`): stored
+    /// members are larger for compressible data but several times faster to write and read.
+    pub fn compression(&mut self, compress: bool) -> &mut Self {
+        self.compress = compress;
+        self
     }
 
     /// Adds an array. `shape` must multiply to the number of values.
@@ -495,11 +512,16 @@ impl NpzWriter {
         self
     }
 
-    /// Writes the archive (deflate-compressed members) to `writer`.
+    /// Writes the archive to `writer` (see [`NpzWriter::compression`]).
     pub fn write_to<W: Write + Seek>(&self, writer: W) -> std::io::Result<()> {
         let mut zip = zip::ZipWriter::new(writer);
+        let method = if self.compress {
+            zip::CompressionMethod::Deflated
+        } else {
+            zip::CompressionMethod::Stored
+        };
         let opts = zip::write::SimpleFileOptions::default()
-            .compression_method(zip::CompressionMethod::Deflated)
+            .compression_method(method)
             .large_file(false);
         for (name, (shape, data)) in &self.members {
             zip.start_file(format!("{name}.npy"), opts)
@@ -552,6 +574,21 @@ mod tests {
         assert_eq!(r.strings("s").unwrap().data, vec!["oval", "figure-eight"]);
         assert!(matches!(r.f64("zzz"), Err(NpzError::Missing { .. })));
         assert!(matches!(r.f64("s"), Err(NpzError::Malformed { .. })));
+    }
+
+    #[test]
+    fn stored_members_round_trip() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("s.npz");
+        let x: Vec<f64> = (0..100).map(|i| i as f64 * 0.5).collect();
+        NpzWriter::new()
+            .compression(false)
+            .add("x", &[10, 10], NpyData::F64(x.clone()))
+            .save(&path)
+            .unwrap();
+        // 100 doubles stored verbatim: the file is larger than the payload.
+        assert!(std::fs::metadata(&path).unwrap().len() > 800);
+        assert_eq!(NpzReader::open(&path).unwrap().f64("x").unwrap().data, x);
     }
 
     #[test]

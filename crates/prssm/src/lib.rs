@@ -10,8 +10,47 @@
 //! with `f` one sparse GP per latent dimension sharing the inducing inputs `Z`, trained by
 //! maximizing a particle-sampled ELBO with exact reverse-mode gradients. The engine knows
 //! nothing about wings: `D_u` inputs, `D_y` outputs, `D_x ≥ D_y` latent states.
+//!
+//! ## Engine API (for the trainer and the CLI)
+//!
+//! - [`ModelConfig`] (sizes, [`KernelKind`], [`CovarianceStructure`], [`Parametrization`],
+//!   jitters, `shared_draws`), [`Params`] (constrained values) ↔ flat unconstrained vector
+//!   ([`Params::unconstrained`], [`Params::from_unconstrained`], [`ParamLayout`]).
+//! - [`Elbo::new`]`(config, `[`TrainingData`]`, `[`ElboOptions`]`)` implements [`Objective`]
+//!   (initial state from [`InitialStateMode`]); [`Elbo::evaluate`] takes per-window initial
+//!   states `N(m₀, diag s₀²)` ([`InitialStates`], row-major `B × D_x`) and returns
+//!   `∂loss/∂m₀`, `∂loss/∂s₀` ([`InitialStateGrads`]) with the parameter gradient.
+//! - [`predict::predict`] / [`predict::predict_with_draws`]: open-loop particle simulation
+//!   ([`predict::Prediction`]); [`predict::StepPredictor`]: one step at a time on caller
+//!   buffers, no allocation per step.
+//! - [`PrssmModel`]: config + params + normalization + training settings; JSON file
+//!   ([`PrssmModel::save`], [`PrssmModel::load`]); [`published::import_published`].
 #![warn(missing_docs)]
 
+pub mod conditional;
+pub mod elbo;
+pub mod io;
+pub mod kernel;
+pub mod kl;
+pub mod linalg;
+pub mod model;
 pub mod objective;
+pub mod params;
+pub mod predict;
+pub mod published;
+pub mod stream;
+pub mod systems;
+pub mod train;
 
+pub use elbo::{
+    Elbo, ElboError, ElboOptions, InitialStateGrads, InitialStateMode, InitialStates, LossParts,
+    LossScaling, Sequence, TrainingData,
+};
+pub use io::ModelFileError;
+pub use kernel::KernelKind;
+pub use model::{Normalization, PrssmModel};
 pub use objective::{Objective, ObjectiveError, Window};
+pub use params::{
+    ConfigError, CovarianceStructure, ModelConfig, ParamGrads, ParamInit, ParamLayout,
+    Parametrization, Params,
+};

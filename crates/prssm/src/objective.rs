@@ -50,6 +50,11 @@ pub trait Objective: Sync {
     ///
     /// # Errors
     /// [`ObjectiveError`] when the evaluation is not possible or not finite.
-    fn loss_and_grad(&self, params: &[f64], batch: &[Window], seed: u64, grad: &mut [f64])
-    -> Result<f64, ObjectiveError>;
+    fn loss_and_grad(
+        &self,
+        params: &[f64],
+        batch: &[Window],
+        seed: u64,
+        grad: &mut [f64],
+    ) -> Result<f64, ObjectiveError>;
 }

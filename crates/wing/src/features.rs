@@ -26,13 +26,30 @@ pub enum FeatureSet {
 
 /// Names of the 11 published features.
 pub const PUBLISHED_NAMES: [&str; 11] = [
-    "v2", "aoa_v2", "aoa2_v2", "aoa3_v2", "alphadot_v", "a_x", "a_y", "alphadot_vx", "alphadot_vy", "alphaddot",
+    "v2",
+    "aoa_v2",
+    "aoa2_v2",
+    "aoa3_v2",
+    "alphadot_v",
+    "a_x",
+    "a_y",
+    "alphadot_vx",
+    "alphadot_vy",
+    "alphaddot",
     "alphadot_absalphadot",
 ];
 
 /// Names of the 10 paper-text features.
 pub const PAPER_TEXT_NAMES: [&str; 10] = [
-    "v2", "aoa_v", "aoa_v2", "aoa_v3", "alphadot_v", "alphadot_absalphadot", "a_x", "a_y", "alphadot_vx",
+    "v2",
+    "aoa_v",
+    "aoa_v2",
+    "aoa_v3",
+    "alphadot_v",
+    "alphadot_absalphadot",
+    "a_x",
+    "a_y",
+    "alphadot_vx",
     "alphadot_vy",
 ];
 

@@ -5,4 +5,12 @@
 //! features, aerodynamic coefficients and stroke cycles. Uses `flapssm-data` for files.
 #![warn(missing_docs)]
 
+pub mod aero;
+pub mod cycles;
+pub mod differentiate;
 pub mod features;
+pub mod kinematics;
+pub mod sensor;
+pub mod trajectories;
+pub mod virtual_wing;
+pub mod vortex;

@@ -1,5 +1,13 @@
 //! One module per subcommand group.
 
+pub mod bench;
+pub mod dataset;
+pub mod model;
+pub mod predict;
+pub mod qs;
+pub mod train;
+pub mod trajectories;
+
 /// `flapssm version`.
 pub fn version() -> anyhow::Result<()> {
     println!("flapssm {}", env!("CARGO_PKG_VERSION"));

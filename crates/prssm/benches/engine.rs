@@ -1,0 +1,112 @@
+//! Engine benchmarks at the paper's configuration (D_x 12, D_u 7, D_y 5, M 100, Matern-3/2,
+//! diagonal unwhitened q(u), 30 particles):
+//! - `elbo/batch16_len470`: one minibatch forward + backward (16 sequences × 470 steps ×
+//!   30 particles = 1/32 of an epoch of 512 sequences);
+//! - `elbo/batch16_len2`: one forward + backward transition step of 480 particle-points
+//!   (plus the per-evaluation K_mm factorization and KL);
+//! - `predict/len470_p30`: one 470-step open-loop prediction with 30 particles (one thread).
+//!
+//! Run: `cargo bench -p flapssm-prssm --bench engine`. The projected epoch time is printed.
+
+use std::hint::black_box;
+use std::time::Instant;
+
+use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
+use flapssm_prssm::predict::predict;
+use flapssm_prssm::{
+    Elbo, ElboOptions, ModelConfig, Objective, ParamInit, Params, Sequence, TrainingData, Window,
+};
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use rand_distr::{Distribution, StandardNormal};
+
+const T: usize = 470;
+
+fn setup() -> (Elbo, Vec<f64>, ModelConfig, Params, Vec<f64>) {
+    let mut rng = ChaCha8Rng::seed_from_u64(0);
+    let config = ModelConfig::new(12, 5, 7, 100);
+    let seqs: Vec<Sequence> = (0..16)
+        .map(|_| Sequence {
+            inputs: (0..T * 7)
+                .map(|_| StandardNormal.sample(&mut rng))
+                .collect(),
+            outputs: (0..T * 5)
+                .map(|_| StandardNormal.sample(&mut rng))
+                .collect(),
+        })
+        .collect();
+    let u = seqs[0].inputs.clone();
+    let data = TrainingData::new(7, 5, seqs).unwrap();
+    let params = Params::init(&config, &ParamInit::default(), 1);
+    let theta = params.unconstrained(&config);
+    let mut opts = ElboOptions::paper(512);
+    opts.windows_per_task = 8;
+    let elbo = Elbo::new(config.clone(), data, opts).unwrap();
+    (elbo, theta, config, params, u)
+}
+
+/// FLOPs of one forward + backward transition step for N points (dominant terms): forward,
+/// recomputation and backward triangular solves (6 M²N), the two L̄ products (4 M²N),
+/// the kernel and its adjoint (12 M N D), mean/variance products (12 M D_x N).
+fn step_flops(n: usize) -> f64 {
+    let (m, d, dx) = (100.0, 19.0, 12.0);
+    let n = n as f64;
+    10.0 * m * m * n + 12.0 * m * n * d + 12.0 * m * dx * n
+}
+
+fn bench(c: &mut Criterion) {
+    let (elbo, theta, config, params, u) = setup();
+    let mut grad = vec![0.0; theta.len()];
+    let mut g = c.benchmark_group("elbo");
+    g.sample_size(10);
+    for len in [2usize, T] {
+        let batch: Vec<Window> = (0..16)
+            .map(|s| Window {
+                sequence: s,
+                start: 0,
+                len,
+            })
+            .collect();
+        g.bench_with_input(BenchmarkId::new("batch16_len", len), &batch, |b, batch| {
+            b.iter(|| {
+                elbo.loss_and_grad(black_box(&theta), batch, 7, &mut grad)
+                    .unwrap()
+            })
+        });
+    }
+    g.finish();
+    // Projection printed once (median of 5 timed minibatches).
+    let batch: Vec<Window> = (0..16)
+        .map(|s| Window {
+            sequence: s,
+            start: 0,
+            len: T,
+        })
+        .collect();
+    let mut times: Vec<f64> = (0..5)
+        .map(|i| {
+            let t0 = Instant::now();
+            elbo.loss_and_grad(&theta, &batch, i, &mut grad).unwrap();
+            t0.elapsed().as_secs_f64()
+        })
+        .collect();
+    times.sort_by(f64::total_cmp);
+    let tb = times[2];
+    let epoch = 32.0 * tb;
+    let gflops = step_flops(480) * (T - 1) as f64 / tb / 1e9;
+    println!(
+        "minibatch (16 × 470 × 30) forward+backward: {tb:.3} s; projected epoch (512 seqs): {epoch:.2} s \
+         (authors: 81.8 s, {:.1}× faster); {gflops:.1} GFLOP/s; threads: {}",
+        81.8 / epoch,
+        rayon::current_num_threads()
+    );
+    let zero = vec![0.0; 12];
+    let mut g = c.benchmark_group("predict");
+    g.bench_function("len470_p30", |b| {
+        b.iter(|| predict(&config, &params, black_box(&u), &zero, &zero, 30, 3).unwrap())
+    });
+    g.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);

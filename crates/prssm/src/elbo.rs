@@ -1,0 +1,723 @@
+//! The particle ELBO of the PR-SSM and its exact gradient (reverse mode through time).
+//!
+//! For a minibatch `B` of windows, `P` particles each, the loss is
+//!
+//! ```text
+//! loss = s · Σ_{b∈B} Σ_p Σ_{t=t₀(b)}^{len_b−1} −ln N(y_{b,t} | x^p_{b,t}[0..D_y], diag σ_y²)  +  KL(q(u) ‖ p(u))
+//! ```
+//! with `s = N_windows / (|B| · P)` ([`LossScaling::Standard`]: an unbiased estimate of the
+//! negative ELBO of a dataset split into `N_windows` windows; use the number of sequences when
+//! each window is a whole sequence) or `s = 1` ([`LossScaling::Published`]: the published
+//! code's sum over particles). `t₀ = ⌊burn_in_fraction · len⌋` (paper: 0.2).
+//!
+//! Particles: `x_0 = m₀ + s₀ ⊙ ε₀`, `x_{t+1} = x_t + μ(x_t, u_t) + √(σ²(x_t, u_t) + σ_x² + δ_t) ⊙ ε_t`,
+//! all `ε ~ N(0, I)` drawn from `ChaCha8Rng::seed_from_u64(seed)` on stream `b` (the batch
+//! position), so results do not depend on the thread count. Windows are processed in fixed
+//! chunks of `windows_per_task`, all particles of a chunk batched per step; chunk results are
+//! reduced in chunk order. The backward pass recomputes each step's conditional from stored
+//! states and draws (memory `O(T · D_x · N)`).
+
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use rand_distr::{Distribution, StandardNormal};
+use serde::{Deserialize, Serialize};
+
+use crate::conditional::{ConditionalGrads, ConditionalWorkspace, Posterior};
+use crate::kernel;
+use crate::kl::kl_divergence;
+use crate::linalg::cholesky_backward;
+use crate::objective::{Objective, ObjectiveError, Window};
+use crate::params::{ConfigError, ModelConfig, ParamGrads, Parametrization, Params};
+
+/// One training sequence in standardized units.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Sequence {
+    /// Inputs `u`, row-major `T × D_u`.
+    pub inputs: Vec<f64>,
+    /// Outputs `y`, row-major `T × D_y`.
+    pub outputs: Vec<f64>,
+}
+
+/// Validated training sequences.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TrainingData {
+    n_input: usize,
+    n_output: usize,
+    sequences: Vec<Sequence>,
+    lens: Vec<usize>,
+}
+
+/// Why an [`Elbo`] could not be built.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum ElboError {
+    /// Invalid model configuration.
+    #[error(transparent)]
+    Config(#[from] ConfigError),
+    /// A sequence has inconsistent shapes or non-finite values.
+    #[error("sequence {index}: {message}")]
+    Sequence {
+        /// Sequence index.
+        index: usize,
+        /// What is wrong.
+        message: String,
+    },
+    /// An option is out of range.
+    #[error("option {field}: {message}")]
+    Option {
+        /// The option.
+        field: &'static str,
+        /// What is wrong.
+        message: String,
+    },
+}
+
+impl TrainingData {
+    /// Checks that every sequence has `T × D_u` inputs and `T × D_y` outputs, `T ≥ 1`, finite.
+    ///
+    /// # Errors
+    /// [`ElboError::Sequence`] naming the sequence.
+    pub fn new(
+        n_input: usize,
+        n_output: usize,
+        sequences: Vec<Sequence>,
+    ) -> Result<Self, ElboError> {
+        let mut lens = Vec::with_capacity(sequences.len());
+        for (index, s) in sequences.iter().enumerate() {
+            let err = |message: String| Err(ElboError::Sequence { index, message });
+            if n_output == 0 || s.outputs.len() % n_output != 0 || s.outputs.is_empty() {
+                return err(format!(
+                    "{} output values are not a T × {n_output} array with T ≥ 1",
+                    s.outputs.len()
+                ));
+            }
+            let t = s.outputs.len() / n_output;
+            if s.inputs.len() != t * n_input {
+                return err(format!(
+                    "{} input values, expected {t} × {n_input}",
+                    s.inputs.len()
+                ));
+            }
+            if let Some(i) = s
+                .inputs
+                .iter()
+                .chain(&s.outputs)
+                .position(|v| !v.is_finite())
+            {
+                return err(format!("non-finite value at flat index {i}"));
+            }
+            lens.push(t);
+        }
+        Ok(Self {
+            n_input,
+            n_output,
+            sequences,
+            lens,
+        })
+    }
+
+    /// The sequences.
+    pub fn sequences(&self) -> &[Sequence] {
+        &self.sequences
+    }
+
+    /// Number of time steps of each sequence.
+    pub fn lens(&self) -> &[usize] {
+        &self.lens
+    }
+}
+
+/// Scaling of the likelihood against the KL term (see the module docs).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum LossScaling {
+    /// Unbiased minibatch estimate: likelihood × `n_windows / (batch · particles)`.
+    Standard {
+        /// Number of windows (sequences) the training data is divided into.
+        n_windows: f64,
+    },
+    /// The published code: likelihood summed over batch and particles, KL added once.
+    Published,
+}
+
+/// Initial-state rule used by the [`Objective`] implementation.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum InitialStateMode {
+    /// `x_0 = 0` for every particle (the paper).
+    Zeros,
+    /// `x_0[0..D_y] = y_{start}`, the rest 0, no spread.
+    Outputs,
+}
+
+/// Options of the ELBO.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ElboOptions {
+    /// Particles per window (paper: 30).
+    pub particles: usize,
+    /// Fraction of each window excluded from the likelihood (paper: 0.2).
+    pub burn_in_fraction: f64,
+    /// Likelihood scaling.
+    pub scaling: LossScaling,
+    /// Initial state used by [`Objective::loss_and_grad`].
+    pub initial_state: InitialStateMode,
+    /// Windows batched together per parallel task (fixed, so results do not depend on the
+    /// number of threads).
+    pub windows_per_task: usize,
+}
+
+impl ElboOptions {
+    /// The paper's options for a dataset of `n_sequences` sequences (standard scaling).
+    pub fn paper(n_sequences: usize) -> Self {
+        Self {
+            particles: 30,
+            burn_in_fraction: 0.2,
+            scaling: LossScaling::Standard {
+                n_windows: n_sequences as f64,
+            },
+            initial_state: InitialStateMode::Zeros,
+            windows_per_task: 4,
+        }
+    }
+}
+
+/// Loss parts of one evaluation.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LossParts {
+    /// `loss = nll + kl`.
+    pub loss: f64,
+    /// The scaled negative log-likelihood term.
+    pub nll: f64,
+    /// `KL(q(u) ‖ p(u))`.
+    pub kl: f64,
+}
+
+/// Initial-state distributions of a batch: `N(mean, diag(std²))`, row-major `B × D_x`.
+#[derive(Debug, Clone, Copy)]
+pub struct InitialStates<'a> {
+    /// Means `m₀`.
+    pub mean: &'a [f64],
+    /// Standard deviations `s₀` (any sign; `x_0 = m₀ + s₀ ε₀`).
+    pub std: &'a [f64],
+}
+
+/// Gradients of the loss w.r.t. the initial states (row-major `B × D_x`, overwritten).
+#[derive(Debug)]
+pub struct InitialStateGrads<'a> {
+    /// `∂loss/∂m₀`.
+    pub mean: &'a mut [f64],
+    /// `∂loss/∂s₀`.
+    pub std: &'a mut [f64],
+}
+
+/// The PR-SSM negative ELBO over a training set: build once, evaluate many times.
+#[derive(Debug, Clone)]
+pub struct Elbo {
+    config: ModelConfig,
+    data: TrainingData,
+    options: ElboOptions,
+}
+
+struct ChunkOut {
+    nll: f64,
+    cond: ConditionalGrads,
+    process_noise: Vec<f64>,
+    obs_noise: Vec<f64>,
+    init_mean: Vec<f64>,
+    init_std: Vec<f64>,
+}
+
+impl Elbo {
+    /// Builds the objective.
+    ///
+    /// # Errors
+    /// [`ElboError`] on an invalid configuration, data of the wrong dimensions or options out
+    /// of range.
+    pub fn new(
+        config: ModelConfig,
+        data: TrainingData,
+        options: ElboOptions,
+    ) -> Result<Self, ElboError> {
+        config.check()?;
+        if data.n_input != config.n_input || data.n_output != config.n_output {
+            return Err(ElboError::Option {
+                field: "data",
+                message: format!(
+                    "data has D_u = {}, D_y = {}; model has D_u = {}, D_y = {}",
+                    data.n_input, data.n_output, config.n_input, config.n_output
+                ),
+            });
+        }
+        if options.particles == 0 {
+            return Err(ElboError::Option {
+                field: "particles",
+                message: "must be ≥ 1".into(),
+            });
+        }
+        if !(0.0..1.0).contains(&options.burn_in_fraction) {
+            return Err(ElboError::Option {
+                field: "burn_in_fraction",
+                message: format!("{} must be in [0, 1)", options.burn_in_fraction),
+            });
+        }
+        if options.windows_per_task == 0 {
+            return Err(ElboError::Option {
+                field: "windows_per_task",
+                message: "must be ≥ 1".into(),
+            });
+        }
+        if let LossScaling::Standard { n_windows } = options.scaling
+            && !(n_windows > 0.0 && n_windows.is_finite())
+        {
+            return Err(ElboError::Option {
+                field: "scaling.n_windows",
+                message: format!("{n_windows} must be > 0"),
+            });
+        }
+        Ok(Self {
+            config,
+            data,
+            options,
+        })
+    }
+
+    /// The model configuration.
+    pub fn config(&self) -> &ModelConfig {
+        &self.config
+    }
+
+    /// The options.
+    pub fn options(&self) -> &ElboOptions {
+        &self.options
+    }
+
+    /// The training data.
+    pub fn data(&self) -> &TrainingData {
+        &self.data
+    }
+
+    /// Writes the initial state of `window` under [`ElboOptions::initial_state`] into `mean`
+    /// and `std` (`D_x` each).
+    pub fn initial_state(&self, window: Window, mean: &mut [f64], std: &mut [f64]) {
+        mean.fill(0.0);
+        std.fill(0.0);
+        if self.options.initial_state == InitialStateMode::Outputs {
+            let dy = self.config.n_output;
+            let s = &self.data.sequences[window.sequence];
+            mean[..dy].copy_from_slice(&s.outputs[window.start * dy..(window.start + 1) * dy]);
+        }
+    }
+
+    fn check_batch(&self, params: &[f64], batch: &[Window]) -> Result<(), ObjectiveError> {
+        let n = self.config.layout().len;
+        if params.len() != n {
+            return Err(ObjectiveError::Shape(format!(
+                "{} parameters, expected {n}",
+                params.len()
+            )));
+        }
+        if params.iter().any(|v| !v.is_finite()) {
+            return Err(ObjectiveError::NonFinite { what: "parameters" });
+        }
+        for (i, w) in batch.iter().enumerate() {
+            let Some(&t) = self.data.lens.get(w.sequence) else {
+                return Err(ObjectiveError::Shape(format!(
+                    "window {i}: sequence {} of {}",
+                    w.sequence,
+                    self.data.lens.len()
+                )));
+            };
+            if w.len == 0 || w.start + w.len > t {
+                return Err(ObjectiveError::Shape(format!(
+                    "window {i}: steps {}..{} of a {t}-step sequence",
+                    w.start,
+                    w.start + w.len
+                )));
+            }
+        }
+        Ok(())
+    }
+
+    /// Evaluates the loss on `batch` with caller-supplied initial states and writes the exact
+    /// gradients w.r.t. the flat parameters (`grad`, `n_params()`) and the initial states.
+    ///
+    /// # Errors
+    /// [`ObjectiveError`] on shape mismatches, a non-positive-definite `K_mm` or a non-finite
+    /// result.
+    pub fn evaluate(
+        &self,
+        params: &[f64],
+        batch: &[Window],
+        init: InitialStates<'_>,
+        seed: u64,
+        grad: &mut [f64],
+        init_grad: InitialStateGrads<'_>,
+    ) -> Result<LossParts, ObjectiveError> {
+        self.check_batch(params, batch)?;
+        let (dx, b_n) = (self.config.n_state, batch.len());
+        for (what, len) in [
+            ("initial mean", init.mean.len()),
+            ("initial std", init.std.len()),
+            ("initial mean gradient", init_grad.mean.len()),
+            ("initial std gradient", init_grad.std.len()),
+        ] {
+            if len != b_n * dx {
+                return Err(ObjectiveError::Shape(format!(
+                    "{what} has {len} values, expected {b_n} × {dx}"
+                )));
+            }
+        }
+        if grad.len() != params.len() {
+            return Err(ObjectiveError::Shape(format!(
+                "gradient has {} values, expected {}",
+                grad.len(),
+                params.len()
+            )));
+        }
+        let cfg = &self.config;
+        let p = Params::from_unconstrained(cfg, params)
+            .map_err(|e| ObjectiveError::Shape(e.to_string()))?;
+        let post = Posterior::new(cfg, &p)?;
+        let lik_scale = match self.options.scaling {
+            LossScaling::Standard { n_windows } => {
+                n_windows / (b_n.max(1) * self.options.particles) as f64
+            }
+            LossScaling::Published => 1.0,
+        };
+        let chunks: Vec<Vec<usize>> = (0..b_n)
+            .collect::<Vec<_>>()
+            .chunks(self.options.windows_per_task)
+            .map(|c| {
+                let mut c = c.to_vec();
+                c.sort_by_key(|&i| std::cmp::Reverse(batch[i].len));
+                c
+            })
+            .collect();
+        let run = |c: &Vec<usize>| self.run_chunk(&post, &p, batch, c, init, seed, lik_scale);
+        #[cfg(feature = "parallel")]
+        let outs: Vec<ChunkOut> = {
+            use rayon::prelude::*;
+            chunks.par_iter().map(run).collect()
+        };
+        #[cfg(not(feature = "parallel"))]
+        let outs: Vec<ChunkOut> = chunks.iter().map(run).collect();
+
+        let mut nll = 0.0;
+        let mut cond = ConditionalGrads::zeros(&post);
+        let mut g = ParamGrads::zeros(cfg);
+        for (c, o) in chunks.iter().zip(&outs) {
+            nll += o.nll;
+            cond.add(&o.cond);
+            g.process_noise_var
+                .iter_mut()
+                .zip(&o.process_noise)
+                .for_each(|(a, b)| *a += b);
+            g.obs_noise_var
+                .iter_mut()
+                .zip(&o.obs_noise)
+                .for_each(|(a, b)| *a += b);
+            for (k, &bi) in c.iter().enumerate() {
+                init_grad.mean[bi * dx..(bi + 1) * dx]
+                    .copy_from_slice(&o.init_mean[k * dx..(k + 1) * dx]);
+                init_grad.std[bi * dx..(bi + 1) * dx]
+                    .copy_from_slice(&o.init_std[k * dx..(k + 1) * dx]);
+            }
+        }
+        let whitened = cfg.parametrization == Parametrization::Whitened;
+        let kl = kl_divergence(
+            (!whitened).then_some(&post.l[..]),
+            post.m,
+            dx,
+            &p.q_mean,
+            &p.q_cov,
+            cfg.covariance,
+        );
+        self.finish_grads(&post, &p, cond, &kl, &mut g);
+        g.to_unconstrained(cfg, params, grad);
+        let loss = nll + kl.value;
+        if !loss.is_finite() {
+            return Err(ObjectiveError::NonFinite { what: "loss" });
+        }
+        if grad.iter().any(|v| !v.is_finite()) {
+            return Err(ObjectiveError::NonFinite { what: "gradient" });
+        }
+        Ok(LossParts {
+            loss,
+            nll,
+            kl: kl.value,
+        })
+    }
+
+    fn finish_grads(
+        &self,
+        post: &Posterior,
+        p: &Params,
+        mut cond: ConditionalGrads,
+        kl: &crate::kl::KlTerms,
+        g: &mut ParamGrads,
+    ) {
+        let (m, d) = (post.m, post.d);
+        g.q_mean
+            .iter_mut()
+            .zip(cond.q_mean.iter().zip(&kl.q_mean))
+            .for_each(|(a, (b, c))| *a += b + c);
+        g.q_cov
+            .iter_mut()
+            .zip(cond.q_cov.iter().zip(&kl.q_cov))
+            .for_each(|(a, (b, c))| *a += b + c);
+        let mut kbar = cholesky_backward(&post.l, &mut cond.lbar, m);
+        if let Some(kk) = &kl.kmm {
+            kbar.iter_mut().zip(kk).for_each(|(a, b)| *a += b);
+        }
+        let mut sv = 0.0;
+        for ((kb, &k), &kd) in kbar.iter_mut().zip(&post.kmm).zip(&post.kmm_kd) {
+            sv += *kb * k;
+            *kb *= kd;
+        }
+        g.kernel_variance += cond.variance + sv / p.kernel_variance;
+        let mut zs = vec![0.0; d * m];
+        kernel::scale_points(&p.inducing_inputs, &post.inv_len, &mut zs);
+        let mut zbar_cols = vec![0.0; m * d];
+        let (mut cx, mut zc, mut rs) = (vec![0.0; m * d], vec![0.0; d * m], vec![0.0; m]);
+        kernel::cross_cov_backward(
+            &kbar,
+            &post.zt,
+            &zs,
+            &post.inv_len,
+            d,
+            &mut cond.zbar_t,
+            &mut zbar_cols,
+            &mut cond.len_acc,
+            &mut cx,
+            &mut zc,
+            &mut rs,
+        );
+        g.inducing_inputs
+            .iter_mut()
+            .zip(&zbar_cols)
+            .for_each(|(a, b)| *a += b);
+        kernel::finish_inducing_grad(&cond.zbar_t, &post.inv_len, &mut g.inducing_inputs);
+        for j in 0..d {
+            g.lengthscales[j] += -2.0 * post.inv_len[j] * cond.len_acc[j];
+        }
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn run_chunk(
+        &self,
+        post: &Posterior,
+        p: &Params,
+        batch: &[Window],
+        chunk: &[usize],
+        init: InitialStates<'_>,
+        seed: u64,
+        lik_scale: f64,
+    ) -> ChunkOut {
+        let cfg = &self.config;
+        let (dx, dy, du, d) = (cfg.n_state, cfg.n_output, cfg.n_input, cfg.n_gp_input());
+        let np = self.options.particles;
+        let nb = chunk.len();
+        let n = nb * np;
+        let t_max = chunk.iter().map(|&i| batch[i].len).max().unwrap_or(0);
+        // Active columns at step t: windows with len > t (chunk sorted by len, descending).
+        let active: Vec<usize> = (0..t_max)
+            .map(|t| chunk.iter().filter(|&&i| batch[i].len > t).count() * np)
+            .collect();
+        let burn: Vec<usize> = chunk
+            .iter()
+            .map(|&i| (self.options.burn_in_fraction * batch[i].len as f64).floor() as usize)
+            .collect();
+        let step = dx * n;
+        let mut xs = vec![0.0; t_max * step];
+        let mut eps = vec![0.0; t_max.saturating_sub(1) * step];
+        let mut eps0 = vec![0.0; step];
+        for (k, &bi) in chunk.iter().enumerate() {
+            let mut rng = ChaCha8Rng::seed_from_u64(seed);
+            rng.set_stream(bi as u64);
+            let cols = k * np..(k + 1) * np;
+            for c in cols.clone() {
+                for dd in 0..dx {
+                    eps0[c * dx + dd] = StandardNormal.sample(&mut rng);
+                }
+            }
+            for t in 0..batch[bi].len - 1 {
+                let e = &mut eps[t * step..(t + 1) * step];
+                for c in cols.clone() {
+                    if cfg.shared_draws {
+                        let v: f64 = StandardNormal.sample(&mut rng);
+                        e[c * dx..(c + 1) * dx].fill(v);
+                    } else {
+                        for dd in 0..dx {
+                            e[c * dx + dd] = StandardNormal.sample(&mut rng);
+                        }
+                    }
+                }
+            }
+            for c in cols {
+                for dd in 0..dx {
+                    xs[c * dx + dd] =
+                        init.mean[bi * dx + dd] + init.std[bi * dx + dd] * eps0[c * dx + dd];
+                }
+            }
+        }
+        let mut ws = ConditionalWorkspace::new(post, n);
+        let vx = &p.process_noise_var;
+        let vy = &p.obs_noise_var;
+        let jit = cfg.transition_jitter;
+        let fill_input = |ws: &mut ConditionalWorkspace, x: &[f64], t: usize, na: usize| {
+            for c in 0..na {
+                let w = batch[chunk[c / np]];
+                let u = &self.data.sequences[w.sequence].inputs
+                    [(w.start + t) * du..(w.start + t + 1) * du];
+                ws.input[c * d..c * d + dx].copy_from_slice(&x[c * dx..(c + 1) * dx]);
+                ws.input[c * d + dx..(c + 1) * d].copy_from_slice(u);
+            }
+        };
+        let half_log_2pi_v: Vec<f64> = vy
+            .iter()
+            .map(|v| 0.5 * (2.0 * std::f64::consts::PI * v).ln())
+            .collect();
+        let mut nll = 0.0;
+        let mut xbar = vec![0.0; step];
+        let mut vy_bar = vec![0.0; dy];
+        // Likelihood at step t: adds to the loss and (if `grad`) to x̄ and σ̄_y².
+        let likelihood = |x: &[f64], t: usize, xbar: Option<&mut [f64]>, vy_bar: &mut [f64]| {
+            let mut acc = 0.0;
+            let mut xbar = xbar;
+            for (k, &bi) in chunk.iter().enumerate() {
+                let w = batch[bi];
+                if t >= w.len || t < burn[k] {
+                    continue;
+                }
+                let y = &self.data.sequences[w.sequence].outputs
+                    [(w.start + t) * dy..(w.start + t + 1) * dy];
+                for c in k * np..(k + 1) * np {
+                    for dd in 0..dy {
+                        let r = y[dd] - x[c * dx + dd];
+                        acc += half_log_2pi_v[dd] + 0.5 * r * r / vy[dd];
+                        if let Some(xb) = xbar.as_deref_mut() {
+                            xb[c * dx + dd] -= lik_scale * r / vy[dd];
+                            vy_bar[dd] +=
+                                lik_scale * 0.5 * (1.0 / vy[dd] - r * r / (vy[dd] * vy[dd]));
+                        }
+                    }
+                }
+            }
+            acc * lik_scale
+        };
+        // Forward.
+        for t in 0..t_max {
+            let (cur, next) = xs.split_at_mut((t + 1) * step);
+            let x = &cur[t * step..];
+            nll += likelihood(x, t, None, &mut vy_bar);
+            if t + 1 < t_max {
+                let na = active[t + 1];
+                fill_input(&mut ws, x, t, na);
+                ws.forward(post, na);
+                let e = &eps[t * step..];
+                let xn = &mut next[..step];
+                for c in 0..na {
+                    for (dd, v) in vx.iter().enumerate() {
+                        let i = c * dx + dd;
+                        let sd = (ws.var[i] + v + jit).sqrt();
+                        xn[i] = x[i] + ws.mean[i] + sd * e[i];
+                    }
+                }
+            }
+        }
+        // Backward.
+        let mut cond = ConditionalGrads::zeros(post);
+        let mut vx_bar = vec![0.0; dx];
+        let mut mean_bar = vec![0.0; step];
+        let mut var_bar = vec![0.0; step];
+        for t in (0..t_max).rev() {
+            let x = &xs[t * step..(t + 1) * step];
+            if t + 1 < t_max {
+                let na = active[t + 1];
+                fill_input(&mut ws, x, t, na);
+                ws.forward(post, na);
+                let e = &eps[t * step..];
+                for c in 0..na {
+                    for dd in 0..dx {
+                        let i = c * dx + dd;
+                        let sd = (ws.var[i] + vx[dd] + jit).sqrt();
+                        mean_bar[i] = xbar[i];
+                        let vb = xbar[i] * e[i] / (2.0 * sd);
+                        var_bar[i] = vb;
+                        vx_bar[dd] += vb;
+                    }
+                }
+                ws.backward(
+                    post,
+                    na,
+                    &mean_bar[..dx * na],
+                    &var_bar[..dx * na],
+                    &mut cond,
+                    &mut xbar,
+                );
+            }
+            likelihood(x, t, Some(&mut xbar), &mut vy_bar);
+        }
+        let mut init_mean = vec![0.0; nb * dx];
+        let mut init_std = vec![0.0; nb * dx];
+        for k in 0..nb {
+            for c in k * np..(k + 1) * np {
+                for dd in 0..dx {
+                    init_mean[k * dx + dd] += xbar[c * dx + dd];
+                    init_std[k * dx + dd] += xbar[c * dx + dd] * eps0[c * dx + dd];
+                }
+            }
+        }
+        ChunkOut {
+            nll,
+            cond,
+            process_noise: vx_bar,
+            obs_noise: vy_bar,
+            init_mean,
+            init_std,
+        }
+    }
+}
+
+impl Objective for Elbo {
+    fn n_params(&self) -> usize {
+        self.config.layout().len
+    }
+
+    fn loss_and_grad(
+        &self,
+        params: &[f64],
+        batch: &[Window],
+        seed: u64,
+        grad: &mut [f64],
+    ) -> Result<f64, ObjectiveError> {
+        let dx = self.config.n_state;
+        let mut mean = vec![0.0; batch.len() * dx];
+        let mut std = vec![0.0; batch.len() * dx];
+        self.check_batch(params, batch)?;
+        for (i, w) in batch.iter().enumerate() {
+            self.initial_state(
+                *w,
+                &mut mean[i * dx..(i + 1) * dx],
+                &mut std[i * dx..(i + 1) * dx],
+            );
+        }
+        let mut gm = vec![0.0; mean.len()];
+        let mut gs = vec![0.0; mean.len()];
+        let parts = self.evaluate(
+            params,
+            batch,
+            InitialStates {
+                mean: &mean,
+                std: &std,
+            },
+            seed,
+            grad,
+            InitialStateGrads {
+                mean: &mut gm,
+                std: &mut gs,
+            },
+        )?;
+        Ok(parts.loss)
+    }
+}

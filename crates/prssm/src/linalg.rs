@@ -1,0 +1,205 @@
+//! Small dense linear-algebra pieces on column-major slices: Cholesky factorization and its
+//! reverse mode (Murray 2016), triangular solves and products through faer.
+
+use faer::linalg::matmul::matmul;
+use faer::linalg::triangular_solve::{
+    solve_lower_triangular_in_place, solve_upper_triangular_in_place,
+};
+use faer::{Accum, MatMut, MatRef, Par};
+
+/// Column-major read-only view of `rows × cols` values.
+#[inline]
+pub(crate) fn view(data: &[f64], rows: usize, cols: usize) -> MatRef<'_, f64> {
+    MatRef::from_column_major_slice(&data[..rows * cols], rows, cols)
+}
+
+/// Column-major mutable view of `rows × cols` values.
+#[inline]
+pub(crate) fn view_mut(data: &mut [f64], rows: usize, cols: usize) -> MatMut<'_, f64> {
+    MatMut::from_column_major_slice_mut(&mut data[..rows * cols], rows, cols)
+}
+
+/// `dst (+)= α · lhs · rhs` (sequential).
+#[inline]
+pub(crate) fn gemm(
+    dst: MatMut<'_, f64>,
+    accum: Accum,
+    lhs: MatRef<'_, f64>,
+    rhs: MatRef<'_, f64>,
+    alpha: f64,
+) {
+    matmul(dst, accum, lhs, rhs, alpha, Par::Seq);
+}
+
+/// `B ← L⁻¹ B` for the lower-triangular `L` (`M × M`) and `B` (`M × N`).
+#[inline]
+pub(crate) fn solve_lower(l: &[f64], m: usize, b: &mut [f64], n: usize) {
+    solve_lower_triangular_in_place(view(l, m, m), view_mut(b, m, n), Par::Seq);
+}
+
+/// `B ← L⁻ᵀ B` for the lower-triangular `L` (`M × M`) and `B` (`M × N`).
+#[inline]
+pub(crate) fn solve_lower_transpose(l: &[f64], m: usize, b: &mut [f64], n: usize) {
+    solve_upper_triangular_in_place(view(l, m, m).transpose(), view_mut(b, m, n), Par::Seq);
+}
+
+/// In-place lower Cholesky factor `A = L Lᵀ` of a column-major `n × n` matrix; the strict
+/// upper triangle is set to zero.
+///
+/// # Errors
+/// `Err(index)`: the pivot `index` is not positive (or not finite).
+pub fn cholesky_in_place(a: &mut [f64], n: usize) -> Result<(), usize> {
+    for j in 0..n {
+        let mut d = a[j * n + j];
+        for k in 0..j {
+            d -= a[k * n + j] * a[k * n + j];
+        }
+        if !(d > 0.0 && d.is_finite()) {
+            return Err(j);
+        }
+        let djj = d.sqrt();
+        a[j * n + j] = djj;
+        for i in j + 1..n {
+            let mut s = a[j * n + i];
+            for k in 0..j {
+                s -= a[k * n + i] * a[k * n + j];
+            }
+            a[j * n + i] = s / djj;
+        }
+        for i in 0..j {
+            a[j * n + i] = 0.0;
+        }
+    }
+    Ok(())
+}
+
+/// Reverse mode of the Cholesky factorization: given `L` and `L̄` (only its lower triangle is
+/// read), returns the symmetric `Σ̄ = sym(L⁻ᵀ Φ(Lᵀ L̄) L⁻¹)`, where `Φ` keeps the lower
+/// triangle and halves the diagonal (Murray 2016). `n × n`, column-major; `lbar` is
+/// overwritten with scratch. Cost `O(n³)`.
+pub fn cholesky_backward(l: &[f64], lbar: &mut [f64], n: usize) -> Vec<f64> {
+    for j in 0..n {
+        for i in 0..j {
+            lbar[j * n + i] = 0.0;
+        }
+    }
+    let mut p = vec![0.0; n * n];
+    gemm(
+        view_mut(&mut p, n, n),
+        Accum::Replace,
+        view(l, n, n).transpose(),
+        view(lbar, n, n),
+        1.0,
+    );
+    for j in 0..n {
+        p[j * n + j] *= 0.5;
+        for i in 0..j {
+            p[j * n + i] = 0.0;
+        }
+    }
+    // Y = L⁻ᵀ P; Σ̄ = Y L⁻¹ = (L⁻ᵀ Yᵀ)ᵀ.
+    solve_lower_transpose(l, n, &mut p, n);
+    let mut yt = vec![0.0; n * n];
+    for j in 0..n {
+        for i in 0..n {
+            yt[j * n + i] = p[i * n + j];
+        }
+    }
+    solve_lower_transpose(l, n, &mut yt, n);
+    // yt now holds Σ̄ᵀ; symmetrize.
+    let mut s = vec![0.0; n * n];
+    for j in 0..n {
+        for i in 0..n {
+            s[j * n + i] = 0.5 * (yt[j * n + i] + yt[i * n + j]);
+        }
+    }
+    s
+}
+
+/// `L⁻¹` of a lower-triangular `n × n` factor (column-major).
+pub fn lower_inverse(l: &[f64], n: usize) -> Vec<f64> {
+    let mut inv = vec![0.0; n * n];
+    for i in 0..n {
+        inv[i * n + i] = 1.0;
+    }
+    solve_lower(l, n, &mut inv, n);
+    inv
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    fn spd(n: usize, rng: &mut ChaCha8Rng) -> Vec<f64> {
+        let b: Vec<f64> = (0..n * n).map(|_| rng.random_range(-1.0..1.0)).collect();
+        let mut a = vec![0.0; n * n];
+        for i in 0..n {
+            for j in 0..n {
+                let mut s = 0.0;
+                for k in 0..n {
+                    s += b[k * n + i] * b[k * n + j];
+                }
+                a[j * n + i] = s + if i == j { n as f64 } else { 0.0 };
+            }
+        }
+        a
+    }
+
+    #[test]
+    fn cholesky_reconstructs() {
+        let mut rng = ChaCha8Rng::seed_from_u64(1);
+        for n in [1, 3, 17] {
+            let a = spd(n, &mut rng);
+            let mut l = a.clone();
+            cholesky_in_place(&mut l, n).unwrap();
+            for i in 0..n {
+                for j in 0..n {
+                    let s: f64 = (0..n).map(|k| l[k * n + i] * l[k * n + j]).sum();
+                    assert!((s - a[j * n + i]).abs() < 1e-12 * n as f64);
+                }
+            }
+        }
+        let mut bad = vec![1.0, 2.0, 2.0, 1.0];
+        assert_eq!(cholesky_in_place(&mut bad, 2), Err(1));
+    }
+
+    #[test]
+    fn cholesky_backward_matches_finite_differences() {
+        // f(A) = Σ W ⊙ chol(A) for a fixed random W; perturb symmetric entries.
+        let mut rng = ChaCha8Rng::seed_from_u64(2);
+        let n = 6;
+        let a = spd(n, &mut rng);
+        let w: Vec<f64> = (0..n * n).map(|_| rng.random_range(-1.0..1.0)).collect();
+        let f = |a: &[f64]| {
+            let mut l = a.to_vec();
+            cholesky_in_place(&mut l, n).unwrap();
+            l.iter().zip(&w).map(|(x, y)| x * y).sum::<f64>()
+        };
+        let mut l = a.clone();
+        cholesky_in_place(&mut l, n).unwrap();
+        let mut lbar = w.clone();
+        let g = cholesky_backward(&l, &mut lbar, n);
+        let h = 1e-6;
+        for i in 0..n {
+            for j in 0..=i {
+                let mut ap = a.clone();
+                let mut am = a.clone();
+                ap[j * n + i] += h;
+                am[j * n + i] -= h;
+                if i != j {
+                    ap[i * n + j] += h;
+                    am[i * n + j] -= h;
+                }
+                let fd = (f(&ap) - f(&am)) / (2.0 * h);
+                let an = if i == j {
+                    g[j * n + i]
+                } else {
+                    2.0 * g[j * n + i]
+                };
+                assert!((fd - an).abs() < 1e-7, "({i},{j}) fd {fd} an {an}");
+            }
+        }
+    }
+}

@@ -1,0 +1,147 @@
+//! [`PrssmModel`]: a trained (or imported) PR-SSM — configuration, parameters, normalization
+//! statistics and the training settings — and prediction in physical units.
+
+use serde::{Deserialize, Serialize};
+
+use crate::objective::ObjectiveError;
+use crate::params::{ConfigError, ModelConfig, Params};
+use crate::predict::{self, Prediction};
+
+/// Per-channel affine normalization `z = (v − mean) / std` of inputs and outputs.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Normalization {
+    /// Input means (`D_u`, physical units).
+    pub input_mean: Vec<f64>,
+    /// Input standard deviations (`D_u`, > 0).
+    pub input_std: Vec<f64>,
+    /// Output means (`D_y`).
+    pub output_mean: Vec<f64>,
+    /// Output standard deviations (`D_y`, > 0).
+    pub output_std: Vec<f64>,
+}
+
+/// A PR-SSM with everything needed to predict.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PrssmModel {
+    /// Structure and sizes.
+    pub config: ModelConfig,
+    /// Constrained parameters.
+    pub params: Params,
+    /// Normalization of inputs/outputs; `None`: the model works on standardized data.
+    pub normalization: Option<Normalization>,
+    /// Free-form training settings (optimizer, epochs, data, ...).
+    pub training: serde_json::Value,
+}
+
+impl PrssmModel {
+    /// Checks configuration, parameter shapes/positivity and normalization shapes.
+    ///
+    /// # Errors
+    /// [`ConfigError`] naming the field.
+    pub fn check(&self) -> Result<(), ConfigError> {
+        self.config.check()?;
+        self.params.check(&self.config)?;
+        if let Some(n) = &self.normalization {
+            for (field, v, len) in [
+                (
+                    "normalization.input_mean",
+                    &n.input_mean,
+                    self.config.n_input,
+                ),
+                ("normalization.input_std", &n.input_std, self.config.n_input),
+                (
+                    "normalization.output_mean",
+                    &n.output_mean,
+                    self.config.n_output,
+                ),
+                (
+                    "normalization.output_std",
+                    &n.output_std,
+                    self.config.n_output,
+                ),
+            ] {
+                if v.len() != len {
+                    return Err(ConfigError {
+                        field,
+                        message: format!("length {}, expected {len}", v.len()),
+                    });
+                }
+                if v.iter().any(|x| !x.is_finite()) {
+                    return Err(ConfigError {
+                        field,
+                        message: "non-finite value".into(),
+                    });
+                }
+            }
+            for (field, v) in [
+                ("normalization.input_std", &n.input_std),
+                ("normalization.output_std", &n.output_std),
+            ] {
+                if v.iter().any(|x| *x <= 0.0) {
+                    return Err(ConfigError {
+                        field,
+                        message: "standard deviations must be > 0".into(),
+                    });
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Open-loop prediction from `x_0 = 0` (all particles) under `inputs` (row-major
+    /// `T × D_u`, physical units if the model has a normalization, else standardized);
+    /// outputs returned in the same units (means de-standardized, variances × std²; latent
+    /// moments stay standardized).
+    ///
+    /// # Errors
+    /// [`ObjectiveError`] on shape mismatches or a non-positive-definite `K_mm`.
+    pub fn predict_inputs(
+        &self,
+        inputs: &[f64],
+        particles: usize,
+        seed: u64,
+    ) -> Result<Prediction, ObjectiveError> {
+        let (dx, du, dy) = (
+            self.config.n_state,
+            self.config.n_input,
+            self.config.n_output,
+        );
+        let zero = vec![0.0; dx];
+        let Some(n) = &self.normalization else {
+            return predict::predict(
+                &self.config,
+                &self.params,
+                inputs,
+                &zero,
+                &zero,
+                particles,
+                seed,
+            );
+        };
+        let z: Vec<f64> = inputs
+            .iter()
+            .enumerate()
+            .map(|(i, v)| (v - n.input_mean[i % du]) / n.input_std[i % du])
+            .collect();
+        let mut p = predict::predict(
+            &self.config,
+            &self.params,
+            &z,
+            &zero,
+            &zero,
+            particles,
+            seed,
+        )?;
+        for (i, (m, v)) in p
+            .output_mean
+            .iter_mut()
+            .zip(p.output_var.iter_mut())
+            .enumerate()
+        {
+            let s = n.output_std[i % dy];
+            *m = *m * s + n.output_mean[i % dy];
+            *v *= s * s;
+        }
+        Ok(p)
+    }
+}

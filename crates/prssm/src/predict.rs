@@ -1,0 +1,328 @@
+//! Open-loop prediction: particles simulated from an initial state through the learned
+//! transition, `x_{t+1} = x_t + μ(x_t, u_t) + √(σ²(x_t, u_t) + σ_x² + δ_t) ⊙ ε_t`.
+//!
+//! Reported moments (as the published code): particle mean, particle variance divided by
+//! `P` (not `P − 1`), plus `σ_y²` for outputs and `σ_x²` for latent states.
+
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use rand_distr::{Distribution, StandardNormal};
+use serde::{Deserialize, Serialize};
+
+use crate::conditional::{ConditionalWorkspace, Posterior};
+use crate::objective::ObjectiveError;
+use crate::params::{ModelConfig, Params};
+
+/// Predictive moments over `T` steps.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Prediction {
+    /// Output means, row-major `T × D_y`.
+    pub output_mean: Vec<f64>,
+    /// Output variances (particle variance + `σ_y²`), row-major `T × D_y`.
+    pub output_var: Vec<f64>,
+    /// Latent means, row-major `T × D_x`.
+    pub latent_mean: Vec<f64>,
+    /// Latent variances (particle variance + `σ_x²`), row-major `T × D_x`.
+    pub latent_var: Vec<f64>,
+}
+
+/// One transition step for `P` particles on caller buffers (for streaming prediction).
+#[derive(Debug, Clone)]
+pub struct StepPredictor {
+    post: Posterior,
+    ws: ConditionalWorkspace,
+    particles: usize,
+    dx: usize,
+    du: usize,
+    process_noise_var: Vec<f64>,
+    jitter: f64,
+    shared_draws: bool,
+}
+
+impl StepPredictor {
+    /// Prepares the conditional (factorizes `K_mm`) and buffers for `particles` particles.
+    ///
+    /// # Errors
+    /// [`ObjectiveError`] on invalid parameters or a non-positive-definite `K_mm`.
+    pub fn new(
+        config: &ModelConfig,
+        params: &Params,
+        particles: usize,
+    ) -> Result<Self, ObjectiveError> {
+        config
+            .check()
+            .map_err(|e| ObjectiveError::Shape(e.to_string()))?;
+        params
+            .check(config)
+            .map_err(|e| ObjectiveError::Shape(e.to_string()))?;
+        if particles == 0 {
+            return Err(ObjectiveError::Shape("particles must be ≥ 1".into()));
+        }
+        let post = Posterior::new(config, params)?;
+        let ws = ConditionalWorkspace::new(&post, particles);
+        Ok(Self {
+            post,
+            ws,
+            particles,
+            dx: config.n_state,
+            du: config.n_input,
+            process_noise_var: params.process_noise_var.clone(),
+            jitter: config.transition_jitter,
+            shared_draws: config.shared_draws,
+        })
+    }
+
+    /// Number of particles.
+    pub fn particles(&self) -> usize {
+        self.particles
+    }
+
+    /// Fills `eps` (`D_x × P`, column-major) with standard-normal draws; with shared draws
+    /// (published compat) one draw per particle is copied to all dims.
+    pub fn draw(&self, rng: &mut impl Rng, eps: &mut [f64]) {
+        StepDraws {
+            dx: self.dx,
+            shared: self.shared_draws,
+        }
+        .fill(rng, eps);
+    }
+
+    /// Advances the particles `x` (`D_x × P`, column-major) by one step under input `u`
+    /// (`D_u`) with draws `eps` (`D_x × P`), in place. Allocates nothing.
+    pub fn step(&mut self, x: &mut [f64], u: &[f64], eps: &[f64]) {
+        let (dx, du) = (self.dx, self.du);
+        let d = dx + du;
+        for c in 0..self.particles {
+            self.ws.input[c * d..c * d + dx].copy_from_slice(&x[c * dx..(c + 1) * dx]);
+            self.ws.input[c * d + dx..(c + 1) * d].copy_from_slice(&u[..du]);
+        }
+        self.ws.forward(&self.post, self.particles);
+        for c in 0..self.particles {
+            for dd in 0..dx {
+                let i = c * dx + dd;
+                let sd = (self.ws.var[i] + self.process_noise_var[dd] + self.jitter).sqrt();
+                x[i] += self.ws.mean[i] + sd * eps[i];
+            }
+        }
+    }
+}
+
+fn moments(
+    x: &[f64],
+    dx: usize,
+    dy: usize,
+    vx: &[f64],
+    vy: &[f64],
+    out: &mut Prediction,
+    t: usize,
+) {
+    let p = (x.len() / dx) as f64;
+    for dd in 0..dx {
+        let mean = x.chunks_exact(dx).map(|c| c[dd]).sum::<f64>() / p;
+        let var = x
+            .chunks_exact(dx)
+            .map(|c| (c[dd] - mean).powi(2))
+            .sum::<f64>()
+            / p;
+        out.latent_mean[t * dx + dd] = mean;
+        out.latent_var[t * dx + dd] = var + vx[dd];
+        if dd < dy {
+            out.output_mean[t * dy + dd] = mean;
+            out.output_var[t * dy + dd] = var + vy[dd];
+        }
+    }
+}
+
+/// Expands per-(step, particle) draws shared by all dims (`S × P`) to `S × P × D_x`.
+pub fn expand_shared_draws(eps: &[f64], dx: usize) -> Vec<f64> {
+    eps.iter()
+        .flat_map(|&e| std::iter::repeat_n(e, dx))
+        .collect()
+}
+
+/// Simulates `P` particles from `x0` (`P × D_x` row-major) under `inputs` (row-major
+/// `T × D_u`) with caller-supplied draws `eps` (`(T − 1) × P × D_x`), returning every
+/// particle (`T × P × D_x`) and the moments.
+///
+/// # Errors
+/// [`ObjectiveError::Shape`] on mismatched lengths; factorization errors.
+pub fn simulate_with_draws(
+    config: &ModelConfig,
+    params: &Params,
+    inputs: &[f64],
+    x0: &[f64],
+    eps: &[f64],
+) -> Result<(Vec<f64>, Prediction), ObjectiveError> {
+    let (dx, du, dy) = (config.n_state, config.n_input, config.n_output);
+    if du == 0 && !inputs.is_empty() || du > 0 && (inputs.is_empty() || inputs.len() % du != 0) {
+        return Err(ObjectiveError::Shape(format!(
+            "{} input values are not a T × {du} array",
+            inputs.len()
+        )));
+    }
+    let t_n = inputs.len().checked_div(du).unwrap_or(1);
+    if x0.is_empty() || x0.len() % dx != 0 {
+        return Err(ObjectiveError::Shape(format!(
+            "initial state has {} values, not P × {dx}",
+            x0.len()
+        )));
+    }
+    let np = x0.len() / dx;
+    if eps.len() != (t_n - 1) * np * dx {
+        return Err(ObjectiveError::Shape(format!(
+            "draws have {} values, expected {} × {np} × {dx}",
+            eps.len(),
+            t_n - 1
+        )));
+    }
+    let mut sp = StepPredictor::new(config, params, np)?;
+    let step = np * dx;
+    let mut all = vec![0.0; t_n * step];
+    all[..step].copy_from_slice(x0);
+    let mut pred = empty_prediction(t_n, dx, dy);
+    moments(
+        &all[..step],
+        dx,
+        dy,
+        &params.process_noise_var,
+        &params.obs_noise_var,
+        &mut pred,
+        0,
+    );
+    for t in 0..t_n - 1 {
+        let (cur, next) = all.split_at_mut((t + 1) * step);
+        next[..step].copy_from_slice(&cur[t * step..]);
+        sp.step(
+            &mut next[..step],
+            &inputs[t * du..(t + 1) * du],
+            &eps[t * step..(t + 1) * step],
+        );
+        moments(
+            &next[..step],
+            dx,
+            dy,
+            &params.process_noise_var,
+            &params.obs_noise_var,
+            &mut pred,
+            t + 1,
+        );
+    }
+    Ok((all, pred))
+}
+
+fn empty_prediction(t_n: usize, dx: usize, dy: usize) -> Prediction {
+    Prediction {
+        output_mean: vec![0.0; t_n * dy],
+        output_var: vec![0.0; t_n * dy],
+        latent_mean: vec![0.0; t_n * dx],
+        latent_var: vec![0.0; t_n * dx],
+    }
+}
+
+/// [`predict`] with caller-supplied draws: `init_draws` (`P × D_x`) for
+/// `x_0 = m₀ + s₀ ⊙ ε₀` and `eps` (`(T − 1) × P × D_x`).
+///
+/// # Errors
+/// As [`simulate_with_draws`].
+pub fn predict_with_draws(
+    config: &ModelConfig,
+    params: &Params,
+    inputs: &[f64],
+    init_mean: &[f64],
+    init_std: &[f64],
+    init_draws: &[f64],
+    eps: &[f64],
+) -> Result<Prediction, ObjectiveError> {
+    let dx = config.n_state;
+    if init_mean.len() != dx || init_std.len() != dx || init_draws.len() % dx != 0 {
+        return Err(ObjectiveError::Shape(format!(
+            "initial state must have {dx} means, {dx} stds and P × {dx} draws"
+        )));
+    }
+    let x0: Vec<f64> = init_draws
+        .chunks_exact(dx)
+        .flat_map(|e| (0..dx).map(move |d| init_mean[d] + init_std[d] * e[d]))
+        .collect();
+    Ok(simulate_with_draws(config, params, inputs, &x0, eps)?.1)
+}
+
+/// Open-loop prediction with `particles` particles from `N(init_mean, diag init_std²)` under
+/// `inputs` (row-major `T × D_u`, standardized as in training); draws from
+/// `ChaCha8Rng::seed_from_u64(seed)` (initial draws first, then step by step).
+/// Cost `O(T · P · (M D + M²))`.
+///
+/// # Errors
+/// As [`simulate_with_draws`].
+pub fn predict(
+    config: &ModelConfig,
+    params: &Params,
+    inputs: &[f64],
+    init_mean: &[f64],
+    init_std: &[f64],
+    particles: usize,
+    seed: u64,
+) -> Result<Prediction, ObjectiveError> {
+    let (dx, du) = (config.n_state, config.n_input.max(1));
+    let t_n = (inputs.len() / du).max(1);
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let init: Vec<f64> = (0..particles * dx)
+        .map(|_| StandardNormal.sample(&mut rng))
+        .collect();
+    let mut eps = vec![0.0; t_n.saturating_sub(1) * particles * dx];
+    StepDraws {
+        dx,
+        shared: config.shared_draws,
+    }
+    .fill(&mut rng, &mut eps);
+    predict_with_draws(config, params, inputs, init_mean, init_std, &init, &eps)
+}
+
+struct StepDraws {
+    dx: usize,
+    shared: bool,
+}
+
+impl StepDraws {
+    fn fill(&self, rng: &mut impl Rng, eps: &mut [f64]) {
+        for e in eps.chunks_exact_mut(self.dx) {
+            if self.shared {
+                let v: f64 = StandardNormal.sample(rng);
+                e.fill(v);
+            } else {
+                for v in e.iter_mut() {
+                    *v = StandardNormal.sample(rng);
+                }
+            }
+        }
+    }
+}
+
+impl Prediction {
+    /// Writes `step, mean_0..mean_{D_y−1}, var_0..var_{D_y−1}` as CSV (atomic), for
+    /// `n_output` outputs.
+    ///
+    /// # Errors
+    /// I/O errors of the atomic write.
+    pub fn write_csv(&self, path: &std::path::Path, n_output: usize) -> std::io::Result<()> {
+        use std::io::Write;
+        let t_n = self.output_mean.len() / n_output.max(1);
+        flapssm_data::atomic::write_atomic(path, |w| {
+            let head: Vec<String> = (0..n_output)
+                .map(|d| format!("mean_{d}"))
+                .chain((0..n_output).map(|d| format!("var_{d}")))
+                .collect();
+            writeln!(w, "step,{}", head.join(","))?;
+            for t in 0..t_n {
+                write!(w, "{t}")?;
+                for v in &self.output_mean[t * n_output..(t + 1) * n_output] {
+                    write!(w, ",{v}")?;
+                }
+                for v in &self.output_var[t * n_output..(t + 1) * n_output] {
+                    write!(w, ",{v}")?;
+                }
+                writeln!(w)?;
+            }
+            Ok(())
+        })
+    }
+}

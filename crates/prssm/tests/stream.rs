@@ -1,0 +1,136 @@
+//! Streaming predictor: identical to the batch prediction draw for draw, and no allocation
+//! per step (counted by a per-thread counting global allocator).
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::cell::Cell;
+
+use flapssm_prssm::params::{ModelConfig, ParamInit, Params};
+use flapssm_prssm::predict;
+use flapssm_prssm::stream::StreamPredictor;
+use flapssm_prssm::train::fit::predict_raw;
+use flapssm_prssm::{Normalization, PrssmModel, Sequence};
+
+struct Counting;
+
+thread_local! {
+    static ALLOCS: Cell<usize> = const { Cell::new(0) };
+}
+
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        ALLOCS.with(|c| c.set(c.get() + 1));
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        unsafe { System.dealloc(ptr, layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        ALLOCS.with(|c| c.set(c.get() + 1));
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+fn allocations() -> usize {
+    ALLOCS.with(|c| c.get())
+}
+
+fn model(dx: usize, dy: usize, du: usize, m: usize, shared: bool) -> PrssmModel {
+    let mut config = ModelConfig::new(dx, dy, du, m);
+    config.shared_draws = shared;
+    let init = ParamInit {
+        q_mean_scale: 0.5,
+        process_noise_var: 1e-3,
+        ..ParamInit::default()
+    };
+    let params = Params::init(&config, &init, 11);
+    PrssmModel {
+        config,
+        params,
+        normalization: Some(Normalization {
+            input_mean: (0..du).map(|i| 0.3 * i as f64).collect(),
+            input_std: (0..du).map(|i| 1.0 + i as f64).collect(),
+            output_mean: (0..dy).map(|i| -1.0 + i as f64).collect(),
+            output_std: (0..dy).map(|i| 2.0 + i as f64).collect(),
+        }),
+        training: serde_json::Value::Null,
+    }
+}
+
+fn inputs(t_n: usize, du: usize) -> Vec<f64> {
+    (0..t_n * du)
+        .map(|i| (0.37 * i as f64).sin() * 2.0 + 0.1 * (i % du) as f64)
+        .collect()
+}
+
+#[test]
+fn streaming_equals_batch_prediction_bit_for_bit() {
+    for (dx, dy, du, shared) in [(4, 1, 1, false), (6, 2, 3, false), (5, 2, 2, true)] {
+        let model = model(dx, dy, du, 12, shared);
+        let t_n = 60;
+        let u = inputs(t_n, du);
+        let seq = Sequence {
+            inputs: u.clone(),
+            outputs: Vec::new(),
+        };
+        let batch = predict_raw(&model, &seq, 25, 99).unwrap();
+        let mut stream =
+            StreamPredictor::new(&model, 25, &vec![0.0; dx], &vec![0.0; dx], 99).unwrap();
+        for t in 0..t_n {
+            let (m, v) = stream.step(&u[t * du..(t + 1) * du]).unwrap();
+            assert_eq!(
+                m,
+                &batch.output_mean[t * dy..(t + 1) * dy],
+                "mean, step {t}"
+            );
+            assert_eq!(
+                v,
+                &batch.output_var[t * dy..(t + 1) * dy],
+                "variance, step {t}"
+            );
+        }
+    }
+}
+
+#[test]
+fn streaming_from_a_gaussian_initial_state_matches_predict() {
+    let model = model(4, 1, 2, 10, false);
+    let mut nonorm = model.clone();
+    nonorm.normalization = None;
+    let m0 = [0.5, -0.2, 0.1, 0.0];
+    let s0 = [0.3, 0.1, 0.2, 0.05];
+    let u = inputs(40, 2);
+    let batch = predict::predict(&nonorm.config, &nonorm.params, &u, &m0, &s0, 17, 5).unwrap();
+    let mut stream = StreamPredictor::new(&nonorm, 17, &m0, &s0, 5).unwrap();
+    for t in 0..40 {
+        let (m, v) = stream.step(&u[t * 2..t * 2 + 2]).unwrap();
+        assert_eq!(m[0], batch.output_mean[t]);
+        assert_eq!(v[0], batch.output_var[t]);
+    }
+    let err = stream.step(&[1.0]).unwrap_err().to_string();
+    assert!(err.contains("expected 2"), "{err}");
+    assert!(stream.step(&[f64::NAN, 0.0]).is_err());
+}
+
+#[test]
+fn a_streaming_step_does_not_allocate() {
+    let model = model(12, 5, 7, 100, false);
+    let u = inputs(50, 7);
+    let mut stream = StreamPredictor::new(&model, 30, &[0.0; 12], &[0.0; 12], 1).unwrap();
+    let mut mean_stream = StreamPredictor::mean_propagated(&model, &[0.0; 12]).unwrap();
+    stream.step(&u[..7]).unwrap();
+    mean_stream.step(&u[..7]).unwrap();
+    let before = allocations();
+    let mut acc = 0.0;
+    for t in 1..50 {
+        let (m, v) = stream.step(&u[t * 7..(t + 1) * 7]).unwrap();
+        acc += m[0] + v[0];
+        let (m, _) = mean_stream.step(&u[t * 7..(t + 1) * 7]).unwrap();
+        acc += m[0];
+    }
+    let after = allocations();
+    assert!(acc.is_finite());
+    assert_eq!(after - before, 0, "allocations during 98 streaming steps");
+}

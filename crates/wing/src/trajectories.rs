@@ -1,0 +1,969 @@
+//! Seeded generator of servo-feasible 3-DoF wing trajectories, and their sampling.
+//!
+//! Every trajectory is an analytic function of time, θ(t) = r(t)·g(2πft) for each Euler angle,
+//! with g a finite Fourier series (rad) and r the C² ramp-in r(t) = 10s³ − 15s⁴ + 6s⁵,
+//! s = min(t/T_ramp, 1), T_ramp = 1–2 cycles. Rates and accelerations are therefore exact
+//! (`θ̇ = ṙg + rġ`, `θ̈ = r̈g + 2ṙġ + rg̈`).
+//!
+//! With x = 2πft the stroke is φ ≈ φ₀ + Φ sin x (plus small harmonics, scaled so that the
+//! half peak-to-peak amplitude is exactly Φ), so φ̇ > 0 around x = 0
+//! and φ̇ < 0 around x = π. Families differ in the deviation ψ:
+//!
+//! | family | deviation ψ |
+//! |---|---|
+//! | figure-eight | Ψ sin(2x + p), tip path crosses itself |
+//! | u-shaped | −Ψ cos(2x + p) (tip rises at both reversals) |
+//! | oval | Ψ cos(x + p) (the two half-strokes at different heights) |
+//! | flat | |ψ| ≤ 3° |
+//! | harmonic | random harmonics 1–3, half peak-to-peak 5–40° (and random harmonics on φ and α) |
+//!
+//! Pitch α = −A_m S(x + δ) − A_d S(x + δ)², with S a Fejér-smoothed square wave (odd harmonics
+//! up to K ∈ {1, 3, 5, 7}) in phase with φ̇ and normalised to S(0) = 1. The two plateau values
+//! −A_1 = −(A_m + A_d) (φ̇ > 0) and A_2 = A_m − A_d (φ̇ < 0) are solved so that the angle of
+//! attack at the plateau centre equals its target exactly: since v = R_z(−α)·v|_{α=0},
+//! AoA(α) = AoA(α = 0) − α. Conventional targets have |AoA| 20–70° with the hovering sign
+//! (AoA·φ̇ < 0); an unconventional half-stroke has |AoA| near zero or the opposite sign
+//! (paper test trajectories #5 and #32).
+
+use crate::cycles::{self, CycleError, U_REF_RADIUS_M};
+use crate::kinematics::{EulerState, WingKinematics};
+use flapssm_data::dataset::{
+    DatasetMeta, FORMAT_VERSION, Fluid, INPUT_UNITS, OUTPUT_UNITS, WingGeometry,
+};
+use flapssm_data::{Dataset, Trajectory};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use serde::{Deserialize, Serialize};
+use std::f64::consts::PI;
+use thiserror::Error;
+
+const DEG: f64 = PI / 180.0;
+/// Grid points per period used to bound the periodic part of each angle.
+const BOUND_GRID: usize = 2048;
+/// Attempts per trajectory before giving up on the feasibility constraints.
+const MAX_ATTEMPTS: usize = 1000;
+
+/// Errors of the trajectory generator.
+#[derive(Debug, Clone, PartialEq, Error)]
+#[non_exhaustive]
+pub enum TrajectoryError {
+    /// A configuration field is out of range.
+    #[error("invalid trajectory config: {field} = {value} ({reason})")]
+    InvalidConfig {
+        /// Field name.
+        field: &'static str,
+        /// Its value.
+        value: f64,
+        /// What is required.
+        reason: &'static str,
+    },
+    /// No feasible trajectory was found for one index.
+    #[error(
+        "trajectory {index}: no feasible trajectory in {attempts} attempts (limits too tight?)"
+    )]
+    Infeasible {
+        /// Trajectory index.
+        index: usize,
+        /// Attempts made.
+        attempts: usize,
+    },
+    /// U_ref could not be computed.
+    #[error("trajectory {index}: U_ref cannot be computed")]
+    Cycle {
+        /// Trajectory index.
+        index: usize,
+        /// Cause.
+        source: CycleError,
+    },
+}
+
+/// Trajectory family (shape of the tip path).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Family {
+    /// Figure-of-eight: deviation at twice the stroke frequency.
+    FigureEight,
+    /// U-shaped: tip rises at both reversals.
+    UShaped,
+    /// Oval: deviation at the stroke frequency.
+    Oval,
+    /// Flat: (almost) no deviation.
+    Flat,
+    /// Free random harmonics on all three angles.
+    Harmonic,
+}
+
+impl Family {
+    /// All families.
+    pub const ALL: [Family; 5] = [
+        Family::FigureEight,
+        Family::UShaped,
+        Family::Oval,
+        Family::Flat,
+        Family::Harmonic,
+    ];
+
+    /// Label stored in datasets.
+    pub fn label(self) -> &'static str {
+        match self {
+            Family::FigureEight => "figure-eight",
+            Family::UShaped => "u-shaped",
+            Family::Oval => "oval",
+            Family::Flat => "flat",
+            Family::Harmonic => "harmonic",
+        }
+    }
+}
+
+/// A finite Fourier series g(x) = c₀ + Σ_{k=1..K} (a_k cos kx + b_k sin kx) (rad).
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+pub struct FourierSeries {
+    /// Constant term c₀ (rad).
+    pub offset_rad: f64,
+    /// a_k, k = 1..K (rad).
+    pub cos_rad: Vec<f64>,
+    /// b_k, k = 1..K (rad); same length as `cos_rad`.
+    pub sin_rad: Vec<f64>,
+}
+
+impl FourierSeries {
+    fn with_len(k: usize) -> Self {
+        Self {
+            offset_rad: 0.0,
+            cos_rad: vec![0.0; k],
+            sin_rad: vec![0.0; k],
+        }
+    }
+
+    fn grow(&mut self, k: usize) {
+        if self.cos_rad.len() < k {
+            self.cos_rad.resize(k, 0.0);
+            self.sin_rad.resize(k, 0.0);
+        }
+    }
+
+    /// Adds a·cos(kx) + b·sin(kx).
+    fn add_harmonic(&mut self, k: usize, a: f64, b: f64) {
+        if k == 0 {
+            self.offset_rad += a;
+            return;
+        }
+        self.grow(k);
+        self.cos_rad[k - 1] += a;
+        self.sin_rad[k - 1] += b;
+    }
+
+    /// Adds amp·sin(kx + p).
+    fn add_sin(&mut self, k: usize, amp: f64, p: f64) {
+        self.add_harmonic(k, amp * p.sin(), amp * p.cos());
+    }
+
+    /// Adds amp·cos(kx + p).
+    fn add_cos(&mut self, k: usize, amp: f64, p: f64) {
+        self.add_harmonic(k, amp * p.cos(), -amp * p.sin());
+    }
+
+    fn scaled(&self, s: f64) -> Self {
+        Self {
+            offset_rad: s * self.offset_rad,
+            cos_rad: self.cos_rad.iter().map(|c| s * c).collect(),
+            sin_rad: self.sin_rad.iter().map(|c| s * c).collect(),
+        }
+    }
+
+    fn add(&mut self, other: &Self) {
+        self.grow(other.cos_rad.len());
+        self.offset_rad += other.offset_rad;
+        for k in 0..other.cos_rad.len() {
+            self.cos_rad[k] += other.cos_rad[k];
+            self.sin_rad[k] += other.sin_rad[k];
+        }
+    }
+
+    /// g(x + δ).
+    fn shifted(&self, delta: f64) -> Self {
+        let mut out = Self::with_len(self.cos_rad.len());
+        out.offset_rad = self.offset_rad;
+        for k in 1..=self.cos_rad.len() {
+            let (s, c) = (k as f64 * delta).sin_cos();
+            let (a, b) = (self.cos_rad[k - 1], self.sin_rad[k - 1]);
+            out.cos_rad[k - 1] = a * c + b * s;
+            out.sin_rad[k - 1] = b * c - a * s;
+        }
+        out
+    }
+
+    /// Product g·h, exact (harmonics up to K_g + K_h).
+    fn product(&self, other: &Self) -> Self {
+        let terms = |f: &Self| {
+            let mut t = vec![(0usize, f.offset_rad, 0.0)];
+            t.extend((1..=f.cos_rad.len()).map(|k| (k, f.cos_rad[k - 1], f.sin_rad[k - 1])));
+            t
+        };
+        let mut out = Self::with_len(self.cos_rad.len() + other.cos_rad.len());
+        for &(j, aj, bj) in &terms(self) {
+            for &(k, ak, bk) in &terms(other) {
+                // (aj cos jx + bj sin jx)(ak cos kx + bk sin kx), with sin 0 = 0 for the constant.
+                let sum = j + k;
+                let diff = j.abs_diff(k);
+                let sgn = if j >= k { 1.0 } else { -1.0 };
+                out.add_harmonic(sum, 0.5 * (aj * ak - bj * bk), 0.5 * (aj * bk + bj * ak));
+                let (dc, ds) = (0.5 * (aj * ak + bj * bk), 0.5 * sgn * (bj * ak - aj * bk));
+                if diff == 0 {
+                    out.offset_rad += dc;
+                } else {
+                    out.add_harmonic(diff, dc, ds);
+                }
+            }
+        }
+        out
+    }
+
+    /// [g, dg/dx, d²g/dx²] at x.
+    pub fn eval(&self, x: f64) -> [f64; 3] {
+        let (s1, c1) = x.sin_cos();
+        let (mut s, mut c) = (0.0, 1.0);
+        let mut out = [self.offset_rad, 0.0, 0.0];
+        for k in 1..=self.cos_rad.len() {
+            (s, c) = (s * c1 + c * s1, c * c1 - s * s1);
+            let (a, b) = (self.cos_rad[k - 1], self.sin_rad[k - 1]);
+            let kf = k as f64;
+            out[0] += a * c + b * s;
+            out[1] += kf * (b * c - a * s);
+            out[2] -= kf * kf * (a * c + b * s);
+        }
+        out
+    }
+
+    /// Half peak-to-peak range (max g − min g)/2 over one period, sampled on a grid.
+    fn half_range(&self) -> f64 {
+        let (lo, hi) = (0..BOUND_GRID).fold((f64::MAX, f64::MIN), |(lo, hi), i| {
+            let v = self.eval(2.0 * PI * i as f64 / BOUND_GRID as f64)[0];
+            (lo.min(v), hi.max(v))
+        });
+        0.5 * (hi - lo)
+    }
+
+    /// Bounds over one period, sampled on a grid: (max |g|, max |dg/dx|).
+    fn bounds(&self) -> (f64, f64) {
+        (0..BOUND_GRID).fold((0.0, 0.0), |(m0, m1), i| {
+            let v = self.eval(2.0 * PI * i as f64 / BOUND_GRID as f64);
+            (f64::max(m0, v[0].abs()), f64::max(m1, v[1].abs()))
+        })
+    }
+}
+
+/// The Fejér-smoothed square wave S(x) (harmonics cos kx, odd k ≤ `k_max`) with S(0) = 1.
+fn smooth_square(k_max: usize) -> FourierSeries {
+    let mut s = FourierSeries::with_len(k_max);
+    for k in (1..=k_max).step_by(2) {
+        let fejer = 1.0 - k as f64 / (k_max as f64 + 1.0);
+        let sign = if (k / 2) % 2 == 0 { 1.0 } else { -1.0 };
+        s.cos_rad[k - 1] = 4.0 / PI * sign * fejer / k as f64;
+    }
+    let s0 = s.eval(0.0)[0];
+    s.scaled(1.0 / s0)
+}
+
+/// One trajectory: an analytic function of time.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TrajectorySpec {
+    /// Family of the tip path.
+    pub family: Family,
+    /// Flapping frequency f (Hz).
+    pub frequency_hz: f64,
+    /// Ramp-in duration T_ramp (s).
+    pub ramp_s: f64,
+    /// Phase x₀ (rad) in x = 2πft + x₀, chosen so that the last dataset sample falls at x ≡ 0
+    /// (mid-stroke, φ̇ > 0), where the published post-processing expects it: its U_ref window
+    /// then starts at a stroke reversal.
+    pub phase_rad: f64,
+    /// Periodic parts g of [φ, ψ, α] as functions of x = 2πft + x₀ (rad).
+    pub angles: [FourierSeries; 3],
+    /// Target signed AoA at the pitch plateau centres of the φ̇ > 0 and φ̇ < 0 half-strokes (rad).
+    pub aoa_targets_rad: [f64; 2],
+}
+
+impl TrajectorySpec {
+    /// Exact Euler angles, rates and accelerations at time `t_s` (s).
+    pub fn euler_state(&self, t_s: f64) -> EulerState {
+        let w = 2.0 * PI * self.frequency_hz;
+        let x = w * t_s + self.phase_rad;
+        let (r, r_d, r_dd) = ramp(t_s, self.ramp_s);
+        let mut st = EulerState::default();
+        for (i, g) in self.angles.iter().enumerate() {
+            let [g0, g1, g2] = g.eval(x);
+            let (g_d, g_dd) = (w * g1, w * w * g2);
+            st.angles_rad[i] = r * g0;
+            st.rates_rad_s[i] = r_d * g0 + r * g_d;
+            st.accels_rad_s2[i] = r_dd * g0 + 2.0 * r_d * g_d + r * g_dd;
+        }
+        st
+    }
+
+    /// Samples `out.len()` states at t = k·`dt_s`, k = 0, 1, …. Allocates nothing.
+    pub fn sample_into(&self, dt_s: f64, out: &mut [EulerState]) {
+        for (k, st) in out.iter_mut().enumerate() {
+            *st = self.euler_state(k as f64 * dt_s);
+        }
+    }
+
+    /// Samples at the raw rate of `cfg` (default 250 Hz, 4700 samples).
+    pub fn sample_raw(&self, cfg: &SamplingConfig) -> Vec<EulerState> {
+        let mut out = vec![EulerState::default(); cfg.n_raw()];
+        self.sample_into(cfg.raw_dt_s(), &mut out);
+        out
+    }
+
+    /// Samples at the dataset rate of `cfg` (every `decimation`-th raw sample; default 25 Hz,
+    /// 470 samples). Identical to decimating [`Self::sample_raw`].
+    pub fn sample_dataset(&self, cfg: &SamplingConfig) -> Vec<EulerState> {
+        let mut out = vec![EulerState::default(); cfg.n_samples];
+        self.sample_into(cfg.dataset_dt_s(), &mut out);
+        out
+    }
+}
+
+/// C² ramp r(t) = 10s³ − 15s⁴ + 6s⁵ (s = t/T clamped to [0, 1]) and its derivatives.
+fn ramp(t_s: f64, ramp_s: f64) -> (f64, f64, f64) {
+    if t_s >= ramp_s {
+        return (1.0, 0.0, 0.0);
+    }
+    if t_s <= 0.0 {
+        return (0.0, 0.0, 0.0);
+    }
+    let s = t_s / ramp_s;
+    let s2 = s * s;
+    (
+        s2 * s * (10.0 - 15.0 * s + 6.0 * s2),
+        30.0 * s2 * (1.0 - s) * (1.0 - s) / ramp_s,
+        60.0 * s * (1.0 - s) * (1.0 - 2.0 * s) / (ramp_s * ramp_s),
+    )
+}
+
+/// Sampling rates and lengths.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SamplingConfig {
+    /// Raw (logging) rate (Hz). Default 250.
+    pub raw_rate_hz: f64,
+    /// Decimation factor from raw to dataset rate. Default 10 (→ 25 Hz).
+    pub decimation: usize,
+    /// Samples per trajectory at the dataset rate. Default 470.
+    pub n_samples: usize,
+}
+
+impl Default for SamplingConfig {
+    fn default() -> Self {
+        Self {
+            raw_rate_hz: 250.0,
+            decimation: 10,
+            n_samples: 470,
+        }
+    }
+}
+
+impl SamplingConfig {
+    /// Raw sampling period (s).
+    pub fn raw_dt_s(&self) -> f64 {
+        1.0 / self.raw_rate_hz
+    }
+
+    /// Dataset sampling period (s).
+    pub fn dataset_dt_s(&self) -> f64 {
+        self.decimation as f64 / self.raw_rate_hz
+    }
+
+    /// Raw samples per trajectory (`n_samples · decimation`).
+    pub fn n_raw(&self) -> usize {
+        self.n_samples * self.decimation
+    }
+}
+
+/// Generator settings (angles in degrees for readability; converted once).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct GeneratorConfig {
+    /// Number of trajectories. Default 548.
+    pub n_trajectories: usize,
+    /// Training trajectories (the first `n_train`). Default 512.
+    pub n_train: usize,
+    /// Seed of the generator.
+    pub seed: u64,
+    /// Sampling.
+    pub sampling: SamplingConfig,
+    /// Flapping frequency range (Hz). Default [0.2, 0.4].
+    pub frequency_hz: [f64; 2],
+    /// Stroke half-amplitude Φ range (deg). Default [40, 100].
+    pub stroke_amplitude_deg: [f64; 2],
+    /// Maximum deviation amplitude Ψ (deg). Default 40.
+    pub max_deviation_deg: f64,
+    /// Conventional mid-stroke |AoA| range (deg). Default [20, 70].
+    pub aoa_deg: [f64; 2],
+    /// Probability that one half-stroke of a trajectory has |AoA| near zero (|AoA| ≤ 8°).
+    pub p_aoa_near_zero: f64,
+    /// Probability that one half-stroke is pitched the wrong way (AoA of opposite sign, 8–20°).
+    pub p_aoa_reversed: f64,
+    /// Ramp-in duration range (cycles). Default [1, 2].
+    pub ramp_cycles: [f64; 2],
+    /// Servo limit on every |angle| (deg). Default 110.
+    pub max_angle_deg: f64,
+    /// Servo limit on every |rate| (deg/s). Default 900.
+    pub max_rate_deg_s: f64,
+    /// Family mix: relative weights of [figure-eight, u-shaped, oval, flat, harmonic].
+    /// Default [0.3, 0.2, 0.2, 0.15, 0.15].
+    pub family_weights: [f64; 5],
+}
+
+impl Default for GeneratorConfig {
+    fn default() -> Self {
+        Self {
+            n_trajectories: 548,
+            n_train: 512,
+            seed: 0,
+            sampling: SamplingConfig::default(),
+            frequency_hz: [0.2, 0.4],
+            stroke_amplitude_deg: [40.0, 100.0],
+            max_deviation_deg: 40.0,
+            aoa_deg: [20.0, 70.0],
+            p_aoa_near_zero: 0.1,
+            p_aoa_reversed: 0.1,
+            ramp_cycles: [1.0, 2.0],
+            max_angle_deg: 110.0,
+            max_rate_deg_s: 900.0,
+            family_weights: [0.3, 0.2, 0.2, 0.15, 0.15],
+        }
+    }
+}
+
+/// Default training count for `n` trajectories: 512 as published when n > 512, otherwise the
+/// published proportion (36 of 548 held out, at least one when n ≥ 2).
+pub fn default_n_train(n: usize) -> usize {
+    if n > 512 {
+        512
+    } else {
+        let n_test = (n * 36).div_ceil(548).max(usize::from(n >= 2));
+        n - n_test
+    }
+}
+
+fn check_range(field: &'static str, r: [f64; 2], lo: f64, hi: f64) -> Result<(), TrajectoryError> {
+    for v in r {
+        if !(v.is_finite() && v >= lo && v <= hi) {
+            return Err(TrajectoryError::InvalidConfig {
+                field,
+                value: v,
+                reason: "out of range",
+            });
+        }
+    }
+    if r[0] > r[1] {
+        return Err(TrajectoryError::InvalidConfig {
+            field,
+            value: r[0],
+            reason: "lower bound above upper bound",
+        });
+    }
+    Ok(())
+}
+
+impl GeneratorConfig {
+    /// Validates every field.
+    pub fn check(&self) -> Result<(), TrajectoryError> {
+        let bad = |field, value: f64, reason| {
+            Err(TrajectoryError::InvalidConfig {
+                field,
+                value,
+                reason,
+            })
+        };
+        if self.n_trajectories == 0 {
+            return bad("n_trajectories", 0.0, "must be positive");
+        }
+        if self.n_train > self.n_trajectories {
+            return bad(
+                "n_train",
+                self.n_train as f64,
+                "must not exceed n_trajectories",
+            );
+        }
+        let s = &self.sampling;
+        if !(s.raw_rate_hz.is_finite() && s.raw_rate_hz > 0.0) {
+            return bad("sampling.raw_rate_hz", s.raw_rate_hz, "must be positive");
+        }
+        if s.decimation == 0 {
+            return bad("sampling.decimation", 0.0, "must be positive");
+        }
+        if s.n_samples < 12 {
+            return bad(
+                "sampling.n_samples",
+                s.n_samples as f64,
+                "must be at least 12",
+            );
+        }
+        check_range(
+            "frequency_hz",
+            self.frequency_hz,
+            1e-3,
+            0.25 / self.sampling.dataset_dt_s(),
+        )?;
+        check_range(
+            "stroke_amplitude_deg",
+            self.stroke_amplitude_deg,
+            1.0,
+            0.95 * self.max_angle_deg,
+        )?;
+        check_range("aoa_deg", self.aoa_deg, 0.0, 89.0)?;
+        check_range("ramp_cycles", self.ramp_cycles, 0.0, 10.0)?;
+        if !(self.max_deviation_deg >= 0.0 && self.max_deviation_deg <= 0.8 * self.max_angle_deg) {
+            return bad(
+                "max_deviation_deg",
+                self.max_deviation_deg,
+                "must be in [0, 0.8·max_angle_deg]",
+            );
+        }
+        if !(self.max_angle_deg > 0.0 && self.max_angle_deg <= 180.0) {
+            return bad("max_angle_deg", self.max_angle_deg, "must be in (0, 180]");
+        }
+        if !(self.max_rate_deg_s.is_finite() && self.max_rate_deg_s > 0.0) {
+            return bad("max_rate_deg_s", self.max_rate_deg_s, "must be positive");
+        }
+        for (field, p) in [
+            ("p_aoa_near_zero", self.p_aoa_near_zero),
+            ("p_aoa_reversed", self.p_aoa_reversed),
+        ] {
+            if !(0.0..=1.0).contains(&p) {
+                return bad(field, p, "must be a probability");
+            }
+        }
+        if self.p_aoa_near_zero + self.p_aoa_reversed > 1.0 {
+            return bad(
+                "p_aoa_reversed",
+                self.p_aoa_reversed,
+                "p_aoa_near_zero + p_aoa_reversed must be ≤ 1",
+            );
+        }
+        if self
+            .family_weights
+            .iter()
+            .any(|w| !(w.is_finite() && *w >= 0.0))
+            || self.family_weights.iter().sum::<f64>() <= 0.0
+        {
+            return bad(
+                "family_weights",
+                self.family_weights.iter().sum(),
+                "must be non-negative with a positive sum",
+            );
+        }
+        Ok(())
+    }
+
+    /// Families of the set, in order: counts proportional to `family_weights` (largest
+    /// remainders; every family with positive weight appears once `n_trajectories` ≥ 5), in an
+    /// order shuffled by `seed`.
+    pub fn family_sequence(&self) -> Vec<Family> {
+        let n = self.n_trajectories;
+        let total: f64 = self.family_weights.iter().sum();
+        let exact: Vec<f64> = self
+            .family_weights
+            .iter()
+            .map(|w| w / total * n as f64)
+            .collect();
+        let mut counts: Vec<usize> = exact
+            .iter()
+            .zip(&self.family_weights)
+            .map(|(e, w)| {
+                if *w > 0.0 && n >= Family::ALL.len() {
+                    (e.floor() as usize).max(1)
+                } else {
+                    e.floor() as usize
+                }
+            })
+            .collect();
+        let mut order: Vec<usize> = (0..counts.len()).collect();
+        order.sort_by(|&a, &b| {
+            (exact[b] - exact[b].floor()).total_cmp(&(exact[a] - exact[a].floor()))
+        });
+        let mut k = 0;
+        while counts.iter().sum::<usize>() < n {
+            counts[order[k % order.len()]] += 1;
+            k += 1;
+        }
+        while counts.iter().sum::<usize>() > n {
+            let i = (0..counts.len()).max_by_key(|&i| counts[i]).unwrap_or(0);
+            counts[i] -= 1;
+        }
+        let mut seq: Vec<Family> = Family::ALL
+            .iter()
+            .zip(&counts)
+            .flat_map(|(f, &c)| std::iter::repeat_n(*f, c))
+            .collect();
+        let mut rng = ChaCha8Rng::seed_from_u64(self.seed);
+        rng.set_stream(u64::MAX);
+        for i in (1..seq.len()).rev() {
+            let j = rng.random_range(0..=i);
+            seq.swap(i, j);
+        }
+        seq
+    }
+
+    /// Generates the trajectory specifications. Trajectory i uses ChaCha8 stream i of `seed`,
+    /// so the result does not depend on threading.
+    pub fn generate(&self) -> Result<Vec<TrajectorySpec>, TrajectoryError> {
+        self.check()?;
+        let families = self.family_sequence();
+        let one = |(i, fam): (usize, &Family)| self.generate_one(i, *fam);
+        #[cfg(feature = "parallel")]
+        {
+            use rayon::prelude::*;
+            families.par_iter().enumerate().map(one).collect()
+        }
+        #[cfg(not(feature = "parallel"))]
+        {
+            families.iter().enumerate().map(one).collect()
+        }
+    }
+
+    /// Generates trajectory `index` of family `family` (deterministic in `seed` and `index`).
+    pub fn generate_one(
+        &self,
+        index: usize,
+        family: Family,
+    ) -> Result<TrajectorySpec, TrajectoryError> {
+        let mut rng = ChaCha8Rng::seed_from_u64(self.seed);
+        rng.set_stream(index as u64);
+        for _ in 0..MAX_ATTEMPTS {
+            let spec = self.draw(&mut rng, family);
+            if let Some(spec) = spec.filter(|s| self.feasible(s)) {
+                return Ok(spec);
+            }
+        }
+        Err(TrajectoryError::Infeasible {
+            index,
+            attempts: MAX_ATTEMPTS,
+        })
+    }
+
+    /// Servo limits: |angle| ≤ max_angle and |rate| ≤ max_rate over the whole trajectory,
+    /// including the ramp (|r| ≤ 1, |ṙ| ≤ 15/(8 T_ramp) bound the ramped values).
+    fn feasible(&self, spec: &TrajectorySpec) -> bool {
+        let w = 2.0 * PI * spec.frequency_hz;
+        let r_dot_max = if spec.ramp_s > 0.0 {
+            15.0 / (8.0 * spec.ramp_s)
+        } else {
+            0.0
+        };
+        spec.angles.iter().all(|g| {
+            let (m0, m1) = g.bounds();
+            m0 <= self.max_angle_deg * DEG && r_dot_max * m0 + w * m1 <= self.max_rate_deg_s * DEG
+        })
+    }
+
+    fn draw(&self, rng: &mut ChaCha8Rng, family: Family) -> Option<TrajectorySpec> {
+        let u = |rng: &mut ChaCha8Rng, r: [f64; 2]| {
+            if r[1] > r[0] {
+                rng.random_range(r[0]..r[1])
+            } else {
+                r[0]
+            }
+        };
+        let f = u(rng, self.frequency_hz);
+        let ramp_s = u(rng, self.ramp_cycles) / f;
+        let amp = u(rng, self.stroke_amplitude_deg) * DEG;
+        let max_dev = self.max_deviation_deg * DEG;
+
+        // Stroke: Φ (sin x + c3 sin 3x + c2 sin 2x) / peak + φ₀.
+        let mut stroke = FourierSeries::default();
+        stroke.add_sin(1, 1.0, 0.0);
+        stroke.add_sin(3, rng.random_range(-0.1..0.03), 0.0);
+        stroke.add_sin(2, rng.random_range(-0.05..0.05), rng.random_range(-PI..PI));
+        if family == Family::Harmonic {
+            for k in 2..=4 {
+                stroke.add_sin(
+                    k,
+                    rng.random_range(0.0..0.12) / k as f64,
+                    rng.random_range(-PI..PI),
+                );
+            }
+        }
+        let mut stroke = stroke.scaled(amp / stroke.half_range());
+        let room = (self.max_angle_deg * DEG - amp).max(0.0);
+        stroke.offset_rad = rng.random_range(-1.0..1.0) * room.min(15.0 * DEG);
+
+        let mut dev = FourierSeries::default();
+        let dev_amp = |rng: &mut ChaCha8Rng, lo: f64| rng.random_range(lo.min(max_dev)..=max_dev);
+        match family {
+            Family::FigureEight => {
+                let a = dev_amp(rng, 8.0 * DEG).min(0.5 * amp);
+                dev.add_sin(2, a, rng.random_range(-0.5..0.5));
+            }
+            Family::UShaped => {
+                let a = dev_amp(rng, 8.0 * DEG).min(0.5 * amp);
+                dev.add_cos(2, -a, rng.random_range(-0.3..0.3));
+            }
+            Family::Oval => {
+                let a = dev_amp(rng, 8.0 * DEG).min(0.5 * amp);
+                dev.add_cos(1, a, rng.random_range(-0.6..0.6));
+            }
+            Family::Flat => {
+                dev.add_sin(
+                    1,
+                    dev_amp(rng, 0.0).min(3.0 * DEG),
+                    rng.random_range(-PI..PI),
+                );
+            }
+            Family::Harmonic => {
+                let total = dev_amp(rng, 5.0 * DEG);
+                let mut weights = [0.0; 3];
+                for (k, wk) in weights.iter_mut().enumerate() {
+                    *wk = rng.random_range(0.0..1.0) / (k + 1) as f64;
+                }
+                weights[0] = weights[0].max(0.2);
+                for (k, wk) in weights.iter().enumerate() {
+                    dev.add_sin(k + 1, *wk, rng.random_range(-PI..PI));
+                }
+                dev = dev.scaled(total / dev.half_range());
+            }
+        }
+        if family != Family::Flat {
+            dev.offset_rad = rng.random_range(-10.0..10.0) * DEG;
+        }
+
+        // Signed AoA targets: conventional AoA·φ̇ < 0, i.e. −|AoA| for φ̇ > 0, +|AoA| for φ̇ < 0.
+        let mut targets = [-u(rng, self.aoa_deg) * DEG, u(rng, self.aoa_deg) * DEG];
+        let which = rng.random_range(0..2usize);
+        let sign = if which == 0 { -1.0 } else { 1.0 };
+        let p: f64 = rng.random();
+        if p < self.p_aoa_near_zero {
+            targets[which] = sign * rng.random_range(-3.0..8.0) * DEG;
+        } else if p < self.p_aoa_near_zero + self.p_aoa_reversed {
+            targets[which] = -sign * rng.random_range(8.0..20.0) * DEG;
+        }
+
+        // Pitch plateaus from AoA(α) = AoA(α = 0) − α at the plateau centres x = −δ, π − δ.
+        let delta = rng.random_range(-0.08..0.08) * 2.0 * PI;
+        let aoa_flat = |x: f64| {
+            let [p0, p1, _] = stroke.eval(x);
+            let [d0, d1, _] = dev.eval(x);
+            let st = EulerState {
+                angles_rad: [p0, d0, 0.0],
+                rates_rad_s: [p1, d1, 0.0],
+                accels_rad_s2: [0.0; 3],
+            };
+            WingKinematics::from_euler(&st).aoa_rad
+        };
+        let wrap = |a: f64| (a + PI).rem_euclid(2.0 * PI) - PI;
+        let alpha_pos = wrap(aoa_flat(-delta) - targets[0]);
+        let alpha_neg = wrap(aoa_flat(PI - delta) - targets[1]);
+        let (a1, a2) = (-alpha_pos, alpha_neg);
+        let k_max = [1, 3, 5, 7][rng.random_range(0..4usize)];
+        let sq = smooth_square(k_max).shifted(delta);
+        let mut pitch = sq.scaled(-0.5 * (a1 + a2));
+        pitch.add(&sq.product(&sq).scaled(-0.5 * (a1 - a2)));
+        if family == Family::Harmonic {
+            // Perturbation vanishing at both plateau centres keeps the AoA targets exact.
+            let mut bump = FourierSeries::default();
+            bump.add_sin(1, rng.random_range(0.0..10.0) * DEG, -delta);
+            let mut wobble = FourierSeries::default();
+            wobble.add_cos(1, 1.0, rng.random_range(-PI..PI));
+            wobble.add_cos(2, 0.5, rng.random_range(-PI..PI));
+            pitch.add(&bump.product(&wobble));
+        }
+        if !(alpha_pos.is_finite() && alpha_neg.is_finite()) {
+            return None;
+        }
+        let t_end = (self.sampling.n_samples - 1) as f64 * self.sampling.dataset_dt_s();
+        let phase_rad = (-2.0 * PI * f * t_end).rem_euclid(2.0 * PI);
+        Some(TrajectorySpec {
+            family,
+            frequency_hz: f,
+            ramp_s,
+            phase_rad,
+            angles: [stroke, dev, pitch],
+            aoa_targets_rad: targets,
+        })
+    }
+}
+
+/// Kinematics-only dataset: analytic inputs at the dataset rate, `outputs = None`, U_ref as
+/// published ([`cycles::published_u_ref`], R = [`U_REF_RADIUS_M`]), family labels, metadata with
+/// generator `"flapssm trajectories"`, the seed and the full [`GeneratorConfig`].
+pub fn kinematics_dataset(cfg: &GeneratorConfig) -> Result<Dataset, TrajectoryError> {
+    let specs = cfg.generate()?;
+    let dt_s = cfg.sampling.dataset_dt_s();
+    let mut trajectories = Vec::with_capacity(specs.len());
+    let mut states = vec![EulerState::default(); cfg.sampling.n_samples];
+    for (index, spec) in specs.iter().enumerate() {
+        spec.sample_into(dt_s, &mut states);
+        let euler_rad: Vec<[f64; 3]> = states.iter().map(|s| s.angles_rad).collect();
+        let inputs = states
+            .iter()
+            .map(|s| WingKinematics::from_euler(s).inputs())
+            .collect();
+        let (u_ref_m_s, _) = cycles::published_u_ref(&euler_rad, dt_s, U_REF_RADIUS_M)
+            .map_err(|source| TrajectoryError::Cycle { index, source })?;
+        trajectories.push(Trajectory {
+            euler_rad,
+            inputs,
+            outputs: None,
+            u_ref_m_s,
+            family: spec.family.label().to_string(),
+        });
+    }
+    let settings = serde_json::to_value(cfg).unwrap_or(serde_json::Value::Null);
+    Ok(Dataset {
+        meta: DatasetMeta {
+            format_version: FORMAT_VERSION,
+            wing: WingGeometry::default(),
+            fluid: Fluid::default(),
+            generator: "flapssm trajectories".to_string(),
+            seed: Some(cfg.seed),
+            settings,
+            input_units: INPUT_UNITS.iter().map(|s| s.to_string()).collect(),
+            output_units: OUTPUT_UNITS.iter().map(|s| s.to_string()).collect(),
+        },
+        dt_s,
+        trajectories,
+        n_train: cfg.n_train,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn pointwise_check(f: &FourierSeries, g: impl Fn(f64) -> f64) {
+        for i in 0..50 {
+            let x = -3.0 + 0.13 * i as f64;
+            assert!(
+                (f.eval(x)[0] - g(x)).abs() < 1e-12,
+                "x = {x}: {} vs {}",
+                f.eval(x)[0],
+                g(x)
+            );
+        }
+    }
+
+    fn sample_series() -> (FourierSeries, FourierSeries) {
+        let mut a = FourierSeries::default();
+        a.offset_rad = 0.3;
+        a.add_sin(1, 0.7, 0.2);
+        a.add_cos(3, -0.4, 1.1);
+        let mut b = FourierSeries::default();
+        b.offset_rad = -0.2;
+        b.add_cos(2, 0.5, -0.7);
+        b.add_sin(1, 0.25, 2.0);
+        (a, b)
+    }
+
+    #[test]
+    fn fourier_algebra_matches_pointwise() {
+        let (a, b) = sample_series();
+        pointwise_check(&a, |x| {
+            0.3 + 0.7 * (x + 0.2).sin() - 0.4 * (3.0 * x + 1.1).cos()
+        });
+        pointwise_check(&a.product(&b), |x| a.eval(x)[0] * b.eval(x)[0]);
+        pointwise_check(&b.product(&a), |x| a.eval(x)[0] * b.eval(x)[0]);
+        pointwise_check(&a.product(&a), |x| a.eval(x)[0].powi(2));
+        pointwise_check(&a.shifted(0.9), |x| a.eval(x + 0.9)[0]);
+        let mut s = a.clone();
+        s.add(&b.scaled(2.0));
+        pointwise_check(&s, |x| a.eval(x)[0] + 2.0 * b.eval(x)[0]);
+    }
+
+    #[test]
+    fn fourier_derivatives_match_central_differences() {
+        let (a, _) = sample_series();
+        let h = 1e-4;
+        for i in 0..20 {
+            let x = 0.31 * i as f64;
+            let [_, d1, d2] = a.eval(x);
+            let (p, m, c) = (a.eval(x + h)[0], a.eval(x - h)[0], a.eval(x)[0]);
+            assert!((d1 - (p - m) / (2.0 * h)).abs() < 1e-7);
+            assert!((d2 - (p - 2.0 * c + m) / (h * h)).abs() < 1e-5);
+        }
+    }
+
+    #[test]
+    fn smooth_square_is_unit_plateau_and_bounded() {
+        for k in [1, 3, 5, 7] {
+            let s = smooth_square(k);
+            assert!((s.eval(0.0)[0] - 1.0).abs() < 1e-14);
+            assert!((s.eval(PI)[0] + 1.0).abs() < 1e-14);
+            assert!(s.bounds().0 <= 1.0 + 1e-12, "K = {k}: max {}", s.bounds().0);
+        }
+    }
+
+    #[test]
+    fn ramp_is_c2_with_exact_derivatives() {
+        let t_r = 3.0;
+        assert_eq!(ramp(0.0, t_r), (0.0, 0.0, 0.0));
+        assert_eq!(ramp(t_r, t_r), (1.0, 0.0, 0.0));
+        let (r, d, dd) = ramp(t_r - 1e-9, t_r);
+        assert!((r - 1.0).abs() < 1e-12 && d.abs() < 1e-12 && dd.abs() < 1e-7);
+        let h = 1e-5;
+        for i in 1..30 {
+            let t = 0.1 * i as f64;
+            let (_, d, dd) = ramp(t, t_r);
+            let (p, m) = (ramp(t + h, t_r), ramp(t - h, t_r));
+            assert!((d - (p.0 - m.0) / (2.0 * h)).abs() < 1e-8);
+            assert!((dd - (p.1 - m.1) / (2.0 * h)).abs() < 1e-7);
+            assert!(d <= 15.0 / (8.0 * t_r) + 1e-15);
+        }
+    }
+
+    #[test]
+    fn family_sequence_follows_weights() {
+        let cfg = GeneratorConfig::default();
+        let seq = cfg.family_sequence();
+        assert_eq!(seq.len(), 548);
+        let count = |f| seq.iter().filter(|&&g| g == f).count();
+        assert_eq!(count(Family::FigureEight), 164); // 0.3 · 548 = 164.4
+        assert_eq!(count(Family::Flat), 82); // 0.15 · 548 = 82.2
+        let small = GeneratorConfig {
+            n_trajectories: 5,
+            n_train: 4,
+            ..GeneratorConfig::default()
+        };
+        let seq = small.family_sequence();
+        assert!(Family::ALL.iter().all(|f| seq.contains(f)));
+    }
+
+    #[test]
+    fn default_split_follows_the_paper() {
+        assert_eq!(default_n_train(548), 512);
+        assert_eq!(default_n_train(1000), 512);
+        assert_eq!(default_n_train(100), 93);
+        assert_eq!(default_n_train(2), 1);
+        assert_eq!(default_n_train(1), 1);
+    }
+
+    #[test]
+    fn bad_config_is_rejected() {
+        let bad = GeneratorConfig {
+            n_train: 600,
+            ..GeneratorConfig::default()
+        };
+        assert!(matches!(
+            bad.check(),
+            Err(TrajectoryError::InvalidConfig {
+                field: "n_train",
+                ..
+            })
+        ));
+        let bad = GeneratorConfig {
+            frequency_hz: [0.4, 0.2],
+            ..GeneratorConfig::default()
+        };
+        assert!(matches!(
+            bad.check(),
+            Err(TrajectoryError::InvalidConfig {
+                field: "frequency_hz",
+                ..
+            })
+        ));
+        let bad = GeneratorConfig {
+            p_aoa_near_zero: 1.5,
+            ..GeneratorConfig::default()
+        };
+        assert!(bad.generate().is_err());
+    }
+}

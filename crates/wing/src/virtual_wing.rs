@@ -1,0 +1,452 @@
+//! The virtual robotic wing: a rigid flat plate flapping in oil, its aerodynamics at a chosen
+//! fidelity, and the measurement chain of the experiment.
+//!
+//! Per trajectory: the Euler angles are sampled at the raw rate (250 Hz), the wing-frame
+//! kinematics ([`WingKinematics`]) drive the blade-element integrator
+//! ([`BladeElement`]) whose strips run the fidelity's [`SectionModel`](crate::aero::SectionModel),
+//! giving F_x, F_y (N) and M_x, M_y, M_z (N·mm) about the sensor origin (default: wing root on
+//! the pitch axis, r_s = r0). The sensor chain ([`crate::sensor`]) adds the experiment's errors,
+//! low-passes and decimates to the dataset rate (25 Hz). Inputs are the analytic 7 inputs at
+//! the dataset rate. Trajectories run in parallel (feature `parallel`); trajectory i uses
+//! ChaCha8 stream i of the seed, so results do not depend on threading.
+
+use crate::aero::SectionModelFactory;
+use crate::aero::blade_element::{AeroError, BladeElement, BladeGeometry};
+use crate::aero::unsteady::UnsteadyParams;
+use crate::cycles::{self, CycleError};
+use crate::kinematics::{EulerState, WingKinematics, rotation_global_from_wing};
+use crate::sensor::{DatasetSensorErrors, SensorConfig, measure};
+use crate::trajectories::{GeneratorConfig, TrajectoryError, TrajectorySpec};
+use flapssm_data::dataset::{
+    DatasetMeta, FORMAT_VERSION, Fluid, INPUT_UNITS, OUTPUT_UNITS, WingGeometry,
+};
+use flapssm_data::{Dataset, Trajectory};
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use serde::{Deserialize, Serialize};
+use thiserror::Error;
+
+/// Standard gravity (m/s²).
+pub const GRAVITY_M_S2: f64 = 9.806_65;
+
+/// Aerodynamic fidelity.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum Fidelity {
+    /// Quasi-steady ([`crate::aero::quasi_steady`]).
+    L0,
+    /// Unsteady low-order ([`crate::aero::unsteady`]).
+    #[default]
+    L1,
+    /// Vortex method strips ([`crate::vortex`]).
+    L2,
+}
+
+impl std::str::FromStr for Fidelity {
+    type Err = SimulateError;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s.to_ascii_lowercase().as_str() {
+            "l0" => Ok(Fidelity::L0),
+            "l1" => Ok(Fidelity::L1),
+            "l2" => Ok(Fidelity::L2),
+            _ => Err(SimulateError::UnknownFidelity {
+                name: s.to_string(),
+            }),
+        }
+    }
+}
+
+/// Errors of the simulator.
+#[derive(Debug, Error)]
+#[non_exhaustive]
+pub enum SimulateError {
+    /// Unknown fidelity name.
+    #[error("unknown fidelity `{name}` (expected l0, l1 or l2)")]
+    UnknownFidelity {
+        /// The name given.
+        name: String,
+    },
+    /// The fidelity has no section model in this build.
+    #[error("fidelity {fidelity:?} is not available: {reason}")]
+    FidelityUnavailable {
+        /// The fidelity asked for.
+        fidelity: Fidelity,
+        /// Why.
+        reason: &'static str,
+    },
+    /// A configuration value is out of range.
+    #[error("invalid simulator setting `{field}` = {value}: {reason}")]
+    InvalidConfig {
+        /// Field name.
+        field: &'static str,
+        /// Its value.
+        value: f64,
+        /// What is required.
+        reason: &'static str,
+    },
+    /// Bad aerodynamic parameters.
+    #[error(transparent)]
+    Aero(#[from] AeroError),
+    /// Trajectory generation failed.
+    #[error(transparent)]
+    Trajectory(#[from] TrajectoryError),
+    /// U_ref of a trajectory could not be computed.
+    #[error("trajectory {index}: U_ref: {source}")]
+    Cycle {
+        /// Trajectory index.
+        index: usize,
+        /// Cause.
+        source: CycleError,
+    },
+    /// Non-finite loads were produced.
+    #[error("trajectory {index}: non-finite load at raw sample {sample}")]
+    NonFinite {
+        /// Trajectory index.
+        index: usize,
+        /// Raw sample index.
+        sample: usize,
+    },
+}
+
+/// The virtual wing: geometry, fluid, fidelity, aerodynamic and sensor parameters.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct VirtualWingConfig {
+    /// Aerodynamic fidelity (L1).
+    pub fidelity: Fidelity,
+    /// Plate geometry (0.18 × 0.06 m, r0 = 0.055 m, pitch axis at 15 % chord, U_ref at 0.235 m).
+    pub wing: WingGeometry,
+    /// Fluid (ρ = 800 kg/m³, ν = 2.2e-5 m²/s: Re = U_ref c/ν ≈ 1000 at U_ref ≈ 0.37 m/s).
+    pub fluid: Fluid,
+    /// Sensor origin on the pitch axis, distance from the stroke axis (m; 0.055 = wing root).
+    pub sensor_radius_m: f64,
+    /// Blade-element strips (Gauss–Legendre; 12).
+    pub n_strips: usize,
+    /// L0/L1 parameters (L0 uses only `aero.quasi_steady`).
+    pub aero: UnsteadyParams,
+    /// Sensor and post-processing.
+    pub sensor: SensorConfig,
+}
+
+impl Default for VirtualWingConfig {
+    fn default() -> Self {
+        let wing = WingGeometry::default();
+        Self {
+            fidelity: Fidelity::L1,
+            sensor_radius_m: wing.root_offset_m,
+            wing,
+            fluid: Fluid::default(),
+            n_strips: 12,
+            aero: UnsteadyParams::default(),
+            sensor: SensorConfig::default(),
+        }
+    }
+}
+
+impl VirtualWingConfig {
+    fn blade_geometry(&self) -> BladeGeometry {
+        BladeGeometry {
+            span_m: self.wing.span_m,
+            chord_m: self.wing.chord_m,
+            root_offset_m: self.wing.root_offset_m,
+            pitch_axis_frac: self.wing.pitch_axis_frac,
+            density_kg_m3: self.fluid.density_kg_m3,
+            sensor_radius_m: self.sensor_radius_m,
+        }
+    }
+
+    /// Validates the configuration.
+    pub fn check(&self) -> Result<(), SimulateError> {
+        self.blade_geometry().check()?;
+        let positive = [
+            (
+                "aero.lev_time_constant_chords",
+                self.aero.lev_time_constant_chords,
+            ),
+            (
+                "aero.inflow_distance_chords",
+                self.aero.inflow_distance_chords,
+            ),
+            ("aero.inflow_decay_rad", self.aero.inflow_decay_rad),
+            (
+                "fluid.kinematic_viscosity_m2_s",
+                self.fluid.kinematic_viscosity_m2_s,
+            ),
+            ("sensor.cutoff_hz", self.sensor.cutoff_hz),
+            ("wing.u_ref_radius_m", self.wing.u_ref_radius_m),
+        ];
+        for (field, value) in positive {
+            if !(value.is_finite() && value > 0.0) {
+                return Err(SimulateError::InvalidConfig {
+                    field,
+                    value,
+                    reason: "must be finite and > 0",
+                });
+            }
+        }
+        if self.n_strips == 0 || self.n_strips > 200 {
+            return Err(SimulateError::InvalidConfig {
+                field: "n_strips",
+                value: self.n_strips as f64,
+                reason: "must be in 1..=200",
+            });
+        }
+        Ok(())
+    }
+
+    /// The section-model factory of the fidelity.
+    pub fn factory(&self) -> Result<Box<dyn SectionModelFactory>, SimulateError> {
+        match self.fidelity {
+            Fidelity::L0 => Ok(Box::new(self.aero.quasi_steady)),
+            Fidelity::L1 => Ok(Box::new(self.aero)),
+            Fidelity::L2 => Err(SimulateError::FidelityUnavailable {
+                fidelity: Fidelity::L2,
+                reason: "the vortex strip model does not implement SectionModelFactory yet",
+            }),
+        }
+    }
+}
+
+/// Everything `flapssm simulate` needs: the wing and the trajectory generator.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+#[serde(default)]
+pub struct SimulationConfig {
+    /// The virtual wing.
+    pub wing: VirtualWingConfig,
+    /// The trajectories (count, split, seed, sampling, families).
+    pub trajectories: GeneratorConfig,
+}
+
+/// A wing ready to run trajectories (holds the per-strip models; reuse it).
+pub struct VirtualWing {
+    cfg: VirtualWingConfig,
+    blade: BladeElement,
+}
+
+impl VirtualWing {
+    /// Builds the wing.
+    pub fn new(cfg: &VirtualWingConfig) -> Result<Self, SimulateError> {
+        cfg.check()?;
+        let factory = cfg.factory()?;
+        let blade = BladeElement::new(cfg.blade_geometry(), cfg.n_strips, factory.as_ref())?;
+        Ok(Self {
+            cfg: cfg.clone(),
+            blade,
+        })
+    }
+
+    /// Exact aerodynamic loads [F_x, F_y (N), M_x, M_y, M_z (N·mm)] for Euler states sampled
+    /// every `dt_s` from rest, written into `out` (same length as `states`).
+    pub fn aero_loads_into(&mut self, states: &[EulerState], dt_s: f64, out: &mut [[f64; 5]]) {
+        self.blade.reset();
+        for (k, (st, y)) in states.iter().zip(out.iter_mut()).enumerate() {
+            let kin = WingKinematics::from_euler(st);
+            *y = self.blade.step(&kin, if k == 0 { 0.0 } else { dt_s });
+        }
+    }
+
+    /// Static (weight − buoyancy) and rigid-plate inertial loads at the sensor for one state.
+    ///
+    /// Plate mass m = ρ_p·h·S and volume h·S, centroid p_c = (0, (x̂0 − ½)c, r0 + span/2) in the
+    /// wing frame, sensor at p_s = (0, 0, r_s). Static: F = R_0wᵀ(0, −(m − ρV)g, 0),
+    /// M = (p_c − p_s) × F. Inertial (d'Alembert): F = −m(ω̇ × p_c + ω × (ω × p_c)),
+    /// M = (p_c − p_s) × F − (I ω̇ + ω × I ω), I = diag(m(c² + s²), m s², m c²)/12.
+    pub fn plate_loads(&self, st: &EulerState) -> ([f64; 5], [f64; 5]) {
+        let w = &self.cfg.wing;
+        let s = &self.cfg.sensor;
+        let volume = s.plate_thickness_m * w.span_m * w.chord_m;
+        let m = s.plate_density_kg_m3 * volume;
+        let r = rotation_global_from_wing(&st.angles_rad);
+        let g_net = -(m - self.cfg.fluid.density_kg_m3 * volume) * GRAVITY_M_S2;
+        let f_static = [r[1][0] * g_net, r[1][1] * g_net, r[1][2] * g_net];
+        let pc = [
+            0.0,
+            (w.pitch_axis_frac - 0.5) * w.chord_m,
+            w.root_offset_m + 0.5 * w.span_m,
+        ];
+        let arm = [pc[0], pc[1], pc[2] - self.cfg.sensor_radius_m];
+        let kin = WingKinematics::from_euler(st);
+        let (om, omd) = (kin.omega_rad_s, kin.omega_dot_rad_s2);
+        let acc = add(cross(omd, pc), cross(om, cross(om, pc)));
+        let f_in = acc.map(|a| -m * a);
+        let inertia = [
+            m * (w.chord_m * w.chord_m + w.span_m * w.span_m) / 12.0,
+            m * w.span_m * w.span_m / 12.0,
+            m * w.chord_m * w.chord_m / 12.0,
+        ];
+        let i_om = [inertia[0] * om[0], inertia[1] * om[1], inertia[2] * om[2]];
+        let i_omd = [
+            inertia[0] * omd[0],
+            inertia[1] * omd[1],
+            inertia[2] * omd[2],
+        ];
+        let gyro = add(i_omd, cross(om, i_om));
+        let m_in = cross(arm, f_in);
+        let m_st = cross(arm, f_static);
+        (
+            [
+                f_static[0],
+                f_static[1],
+                1e3 * m_st[0],
+                1e3 * m_st[1],
+                1e3 * m_st[2],
+            ],
+            [
+                f_in[0],
+                f_in[1],
+                1e3 * (m_in[0] - gyro[0]),
+                1e3 * (m_in[1] - gyro[1]),
+                1e3 * (m_in[2] - gyro[2]),
+            ],
+        )
+    }
+
+    /// Simulates one trajectory: raw loads, sensor chain, decimation, inputs and U_ref.
+    pub fn simulate(
+        &mut self,
+        spec: &TrajectorySpec,
+        sampling: &crate::trajectories::SamplingConfig,
+        index: usize,
+        errors: &DatasetSensorErrors,
+        rng: &mut ChaCha8Rng,
+    ) -> Result<Trajectory, SimulateError> {
+        let states = spec.sample_raw(sampling);
+        let mut raw = vec![[0.0; 5]; states.len()];
+        self.aero_loads_into(&states, sampling.raw_dt_s(), &mut raw);
+        if let Some(sample) = raw.iter().position(|y| y.iter().any(|v| !v.is_finite())) {
+            return Err(SimulateError::NonFinite { index, sample });
+        }
+        let (static_loads, inertial_loads): (Vec<[f64; 5]>, Vec<[f64; 5]>) =
+            if self.cfg.sensor.static_residual || self.cfg.sensor.inertial_residual {
+                states.iter().map(|st| self.plate_loads(st)).unzip()
+            } else {
+                (vec![[0.0; 5]; states.len()], vec![[0.0; 5]; states.len()])
+            };
+        let mut outputs = measure(
+            &self.cfg.sensor,
+            errors,
+            &mut raw,
+            &static_loads,
+            &inertial_loads,
+            sampling.raw_rate_hz,
+            sampling.decimation,
+            rng,
+        );
+        outputs.truncate(sampling.n_samples);
+        let decimated: Vec<&EulerState> = states
+            .iter()
+            .step_by(sampling.decimation.max(1))
+            .take(sampling.n_samples)
+            .collect();
+        let euler_rad: Vec<[f64; 3]> = decimated.iter().map(|s| s.angles_rad).collect();
+        let inputs = decimated
+            .iter()
+            .map(|s| WingKinematics::from_euler(s).inputs())
+            .collect();
+        let dt_s = sampling.dataset_dt_s();
+        let (u_ref_m_s, _) =
+            cycles::published_u_ref(&euler_rad, dt_s, self.cfg.wing.u_ref_radius_m)
+                .map_err(|source| SimulateError::Cycle { index, source })?;
+        Ok(Trajectory {
+            euler_rad,
+            inputs,
+            outputs: Some(outputs),
+            u_ref_m_s,
+            family: spec.family.label().to_string(),
+        })
+    }
+}
+
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+fn add(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
+}
+
+/// Seed offset of the sensor streams (independent of the trajectory generator's streams).
+const SENSOR_SEED_SALT: u64 = 0x5e45_0f0a_11ce_d00d;
+
+/// Simulates a whole dataset: generates the trajectories of `cfg.trajectories`, runs the wing
+/// on each (in parallel with feature `parallel`; `progress` is called once per finished
+/// trajectory) and assembles the [`Dataset`] with generator `"flapssm simulate"` and settings
+/// {fidelity, the whole `SimulationConfig`, the per-dataset sensor errors, mean Re}.
+pub fn simulate_dataset(
+    cfg: &SimulationConfig,
+    progress: &(dyn Fn() + Sync),
+) -> Result<Dataset, SimulateError> {
+    cfg.wing.check()?;
+    cfg.wing.factory()?;
+    let specs = cfg.trajectories.generate()?;
+    let sampling = &cfg.trajectories.sampling;
+    let seed = cfg.trajectories.seed ^ SENSOR_SEED_SALT;
+    let mut dataset_rng = ChaCha8Rng::seed_from_u64(seed);
+    dataset_rng.set_stream(u64::MAX);
+    let errors = DatasetSensorErrors::draw(&cfg.wing.sensor, &mut dataset_rng);
+    let run_one = |wing: &mut Result<VirtualWing, SimulateError>,
+                   (index, spec): (usize, &TrajectorySpec)| {
+        let wing = wing.as_mut().map_err(|e| SimulateError::InvalidConfig {
+            field: "wing",
+            value: f64::NAN,
+            reason: if matches!(e, SimulateError::FidelityUnavailable { .. }) {
+                "fidelity unavailable"
+            } else {
+                "invalid"
+            },
+        })?;
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        rng.set_stream(index as u64);
+        let t = wing.simulate(spec, sampling, index, &errors, &mut rng);
+        progress();
+        t
+    };
+    #[cfg(feature = "parallel")]
+    let trajectories: Result<Vec<Trajectory>, SimulateError> = {
+        use rayon::prelude::*;
+        specs
+            .par_iter()
+            .enumerate()
+            .map_init(|| VirtualWing::new(&cfg.wing), run_one)
+            .collect()
+    };
+    #[cfg(not(feature = "parallel"))]
+    let trajectories: Result<Vec<Trajectory>, SimulateError> = {
+        let mut wing = VirtualWing::new(&cfg.wing);
+        specs
+            .iter()
+            .enumerate()
+            .map(|x| run_one(&mut wing, x))
+            .collect()
+    };
+    let trajectories = trajectories?;
+    let n = trajectories.len().max(1) as f64;
+    let mean_u_ref = trajectories.iter().map(|t| t.u_ref_m_s).sum::<f64>() / n;
+    let reynolds = mean_u_ref * cfg.wing.wing.chord_m / cfg.wing.fluid.kinematic_viscosity_m2_s;
+    let settings = serde_json::json!({
+        "fidelity": cfg.wing.fidelity,
+        "simulation": cfg,
+        "sensor_errors": errors,
+        "mean_u_ref_m_s": mean_u_ref,
+        "mean_reynolds_number": reynolds,
+    });
+    Ok(Dataset {
+        meta: DatasetMeta {
+            format_version: FORMAT_VERSION,
+            wing: cfg.wing.wing.clone(),
+            fluid: cfg.wing.fluid.clone(),
+            generator: "flapssm simulate".to_string(),
+            seed: Some(cfg.trajectories.seed),
+            settings,
+            input_units: INPUT_UNITS.iter().map(|s| s.to_string()).collect(),
+            output_units: OUTPUT_UNITS.iter().map(|s| s.to_string()).collect(),
+        },
+        dt_s: sampling.dataset_dt_s(),
+        trajectories,
+        n_train: cfg.trajectories.n_train,
+    })
+}

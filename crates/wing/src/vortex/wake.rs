@@ -1,0 +1,394 @@
+//! Free point vortices: storage (allocated once), induced velocities with a Vatistas (n = 2)
+//! core, convection, decay, far-field deletion and Spalart amalgamation.
+//!
+//! Velocity induced at point P by a counter-clockwise vortex Γ (m²/s) at P_k, d = P − P_k:
+//!
+//! u = Γ/(2π) · (−d_z, d_x) / sqrt(r_c⁴ + |d|⁴)   (m/s).
+
+use std::f64::consts::PI;
+
+/// Where a free vortex was shed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum VortexKind {
+    /// Trailing-edge vortex.
+    Tev,
+    /// Leading-edge vortex.
+    Lev,
+}
+
+/// The free vortices (structure of arrays, capacity fixed at construction).
+#[derive(Debug, Clone)]
+pub struct Wake {
+    x: Vec<f64>,
+    z: Vec<f64>,
+    gamma: Vec<f64>,
+    kind: Vec<VortexKind>,
+    u: Vec<f64>,
+    w: Vec<f64>,
+    keep: Vec<bool>,
+    best: Vec<(f64, u32, u32)>,
+    /// Index of the newest TEV / LEV (protected from merging; used to place the next one).
+    pub(crate) last_tev: Option<usize>,
+    pub(crate) last_lev: Option<usize>,
+}
+
+/// Adds to (u, w) the velocity at (px, pz) induced by vortices (xs, zs, gs).
+#[inline(always)]
+pub(crate) fn induced_at(
+    px: f64,
+    pz: f64,
+    xs: &[f64],
+    zs: &[f64],
+    gs: &[f64],
+    rc4: f64,
+) -> (f64, f64) {
+    let (mut u, mut w) = (0.0, 0.0);
+    for ((&x, &z), &g) in xs.iter().zip(zs).zip(gs) {
+        let dx = px - x;
+        let dz = pz - z;
+        let d2 = dx * dx + dz * dz;
+        let f = g / (rc4 + d2 * d2).sqrt();
+        u -= dz * f;
+        w += dx * f;
+    }
+    (u / (2.0 * PI), w / (2.0 * PI))
+}
+
+impl Wake {
+    /// Empty wake able to hold `capacity` vortices without reallocating.
+    pub fn with_capacity(capacity: usize) -> Self {
+        Self {
+            x: Vec::with_capacity(capacity),
+            z: Vec::with_capacity(capacity),
+            gamma: Vec::with_capacity(capacity),
+            kind: Vec::with_capacity(capacity),
+            u: Vec::with_capacity(capacity),
+            w: Vec::with_capacity(capacity),
+            keep: Vec::with_capacity(capacity),
+            best: Vec::with_capacity(capacity),
+            last_tev: None,
+            last_lev: None,
+        }
+    }
+
+    /// Removes every vortex (keeps the storage).
+    pub fn clear(&mut self) {
+        self.x.clear();
+        self.z.clear();
+        self.gamma.clear();
+        self.kind.clear();
+        self.u.clear();
+        self.w.clear();
+        self.last_tev = None;
+        self.last_lev = None;
+    }
+
+    /// Number of free vortices.
+    pub fn len(&self) -> usize {
+        self.x.len()
+    }
+
+    /// True when there are no free vortices.
+    pub fn is_empty(&self) -> bool {
+        self.x.is_empty()
+    }
+
+    /// Storage capacity (vortices).
+    pub fn capacity(&self) -> usize {
+        self.x.capacity()
+    }
+
+    /// X positions (m).
+    pub fn x_m(&self) -> &[f64] {
+        &self.x
+    }
+
+    /// Z positions (m).
+    pub fn z_m(&self) -> &[f64] {
+        &self.z
+    }
+
+    /// Counter-clockwise circulations Γ (m²/s).
+    pub fn gamma_m2_s(&self) -> &[f64] {
+        &self.gamma
+    }
+
+    /// Origins of the vortices.
+    pub fn kinds(&self) -> &[VortexKind] {
+        &self.kind
+    }
+
+    /// Σ Γ of the free vortices (m²/s).
+    pub fn total_circulation(&self) -> f64 {
+        self.gamma.iter().sum()
+    }
+
+    /// Velocity (m/s) induced at (px, pz) by all free vortices.
+    pub fn velocity_at(&self, px: f64, pz: f64, rc4: f64) -> (f64, f64) {
+        induced_at(px, pz, &self.x, &self.z, &self.gamma, rc4)
+    }
+
+    /// Appends a vortex; returns its index. The caller guarantees `len() < capacity()`.
+    pub(crate) fn push(&mut self, x: f64, z: f64, gamma: f64, kind: VortexKind) -> usize {
+        debug_assert!(self.len() < self.capacity());
+        self.x.push(x);
+        self.z.push(z);
+        self.gamma.push(gamma);
+        self.kind.push(kind);
+        self.u.push(0.0);
+        self.w.push(0.0);
+        let i = self.x.len() - 1;
+        match kind {
+            VortexKind::Tev => self.last_tev = Some(i),
+            VortexKind::Lev => self.last_lev = Some(i),
+        }
+        i
+    }
+
+    /// Position of vortex `i`.
+    pub(crate) fn pos(&self, i: usize) -> (f64, f64) {
+        (self.x[i], self.z[i])
+    }
+
+    /// Sets (u, w) of every vortex to the velocity induced by the other free vortices plus the
+    /// bound elements (bx, bz, counter-clockwise circulations bg). O(N² / 2 + N·n_bound).
+    pub(crate) fn compute_velocities(&mut self, bx: &[f64], bz: &[f64], bg: &[f64], rc4: f64) {
+        let n = self.len();
+        for i in 0..n {
+            let (u, w) = induced_at(self.x[i], self.z[i], bx, bz, bg, rc4);
+            self.u[i] = u;
+            self.w[i] = w;
+        }
+        let inv2pi = 1.0 / (2.0 * PI);
+        for i in 0..n {
+            let (xi, zi, gi) = (self.x[i], self.z[i], self.gamma[i]);
+            let (mut ui, mut wi) = (0.0, 0.0);
+            for j in (i + 1)..n {
+                let dx = xi - self.x[j];
+                let dz = zi - self.z[j];
+                let d2 = dx * dx + dz * dz;
+                let f = inv2pi / (rc4 + d2 * d2).sqrt();
+                // velocity at i from j, and at j from i (d reversed)
+                let gj = self.gamma[j];
+                ui -= dz * f * gj;
+                wi += dx * f * gj;
+                self.u[j] += dz * f * gi;
+                self.w[j] -= dx * f * gi;
+            }
+            self.u[i] += ui;
+            self.w[i] += wi;
+        }
+    }
+
+    /// Moves every vortex by its stored velocity times `dt_s` (forward Euler).
+    pub(crate) fn convect(&mut self, dt_s: f64) {
+        for i in 0..self.len() {
+            self.x[i] += self.u[i] * dt_s;
+            self.z[i] += self.w[i] * dt_s;
+        }
+    }
+
+    /// Multiplies TEV circulations by `f_tev` and LEV circulations by `f_lev`.
+    pub(crate) fn decay(&mut self, f_tev: f64, f_lev: f64) {
+        for (g, k) in self.gamma.iter_mut().zip(&self.kind) {
+            *g *= match k {
+                VortexKind::Tev => f_tev,
+                VortexKind::Lev => f_lev,
+            };
+        }
+    }
+
+    /// Marks for deletion every vortex farther than sqrt(r2_max) from (px, pz); then compacts.
+    pub(crate) fn delete_far(&mut self, px: f64, pz: f64, r2_max: f64) {
+        self.keep.clear();
+        let mut any = false;
+        for i in 0..self.len() {
+            let d2 = (self.x[i] - px).powi(2) + (self.z[i] - pz).powi(2);
+            let k = d2 <= r2_max;
+            any |= !k;
+            self.keep.push(k);
+        }
+        if any {
+            self.compact();
+        }
+    }
+
+    /// Spalart amalgamation (see [`MergeParams`](super::MergeParams)); `v0_dim` = V0 in 1/s,
+    /// `d0_m` = D0 in m, distances d measured to the plate segment `le`–`te`. Merges pairs below
+    /// the threshold (only vortices farther than `near_m` from the plate), then more pairs
+    /// (smallest measure first, any distance) while the count exceeds `target`. Never merges the
+    /// newest TEV/LEV. Conserves Σ Γ.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn amalgamate(&mut self, le: [f64; 2], te: [f64; 2], d0_m: f64, near_m: f64, v0_dim: f64, target: usize) {
+        let n = self.len();
+        if n < 2 {
+            return;
+        }
+        let seg = [te[0] - le[0], te[1] - le[1]];
+        let seg2 = (seg[0] * seg[0] + seg[1] * seg[1]).max(f64::MIN_POSITIVE);
+        let dist = |x: f64, z: f64| {
+            let s = (((x - le[0]) * seg[0] + (z - le[1]) * seg[1]) / seg2).clamp(0.0, 1.0);
+            (x - le[0] - s * seg[0]).hypot(z - le[1] - s * seg[1])
+        };
+        let protected = |i: usize, s: &Self| s.last_tev == Some(i) || s.last_lev == Some(i);
+        let forced = n > target;
+        self.best.clear();
+        for i in 0..n {
+            let di = dist(self.x[i], self.z[i]);
+            if protected(i, self) || (!forced && di < near_m) {
+                continue;
+            }
+            let gi = self.gamma[i];
+            let mut best = (f64::INFINITY, 0u32);
+            for j in (i + 1)..n {
+                let gj = self.gamma[j];
+                if gi * gj <= 0.0 || protected(j, self) {
+                    continue;
+                }
+                let dj = dist(self.x[j], self.z[j]);
+                if !forced && dj < near_m {
+                    continue;
+                }
+                let dij = (self.x[i] - self.x[j]).hypot(self.z[i] - self.z[j]);
+                let m = (gi * gj).abs() / (gi + gj).abs() * dij / ((d0_m + di) * (d0_m + dj)).powf(1.5);
+                if m < best.0 {
+                    best = (m, j as u32);
+                }
+            }
+            if best.0.is_finite() {
+                self.best.push((best.0, i as u32, best.1));
+            }
+        }
+        self.best.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
+        self.keep.clear();
+        self.keep.resize(n, true);
+        let mut count = n;
+        for k in 0..self.best.len() {
+            let (m, i, j) = self.best[k];
+            let (i, j) = (i as usize, j as usize);
+            if m >= v0_dim && count <= target {
+                break;
+            }
+            if !self.keep[i] || !self.keep[j] {
+                continue;
+            }
+            let (gi, gj) = (self.gamma[i], self.gamma[j]);
+            let g = gi + gj;
+            self.x[i] = (gi * self.x[i] + gj * self.x[j]) / g;
+            self.z[i] = (gi * self.z[i] + gj * self.z[j]) / g;
+            self.u[i] = (gi * self.u[i] + gj * self.u[j]) / g;
+            self.w[i] = (gi * self.w[i] + gj * self.w[j]) / g;
+            if gj.abs() > gi.abs() {
+                self.kind[i] = self.kind[j];
+            }
+            self.gamma[i] = g;
+            self.keep[j] = false;
+            count -= 1;
+        }
+        if count < n {
+            self.compact();
+        }
+    }
+
+    /// Removes the weakest unprotected vortex (last resort when amalgamation cannot make room;
+    /// loses its circulation).
+    pub(crate) fn remove_weakest(&mut self) {
+        let mut weakest = None;
+        for i in 0..self.len() {
+            if self.last_tev == Some(i) || self.last_lev == Some(i) {
+                continue;
+            }
+            if weakest.is_none_or(|k: usize| self.gamma[i].abs() < self.gamma[k].abs()) {
+                weakest = Some(i);
+            }
+        }
+        let Some(k) = weakest else { return };
+        self.keep.clear();
+        self.keep.resize(self.len(), true);
+        self.keep[k] = false;
+        self.compact();
+    }
+
+    /// Removes the vortices with `keep[i] == false`, preserving order and the newest indices.
+    fn compact(&mut self) {
+        let n = self.len();
+        let mut dst = 0;
+        let (mut tev, mut lev) = (None, None);
+        for src in 0..n {
+            if !self.keep[src] {
+                continue;
+            }
+            self.x[dst] = self.x[src];
+            self.z[dst] = self.z[src];
+            self.gamma[dst] = self.gamma[src];
+            self.kind[dst] = self.kind[src];
+            self.u[dst] = self.u[src];
+            self.w[dst] = self.w[src];
+            if self.last_tev == Some(src) {
+                tev = Some(dst);
+            }
+            if self.last_lev == Some(src) {
+                lev = Some(dst);
+            }
+            dst += 1;
+        }
+        self.last_tev = tev;
+        self.last_lev = lev;
+        self.x.truncate(dst);
+        self.z.truncate(dst);
+        self.gamma.truncate(dst);
+        self.kind.truncate(dst);
+        self.u.truncate(dst);
+        self.w.truncate(dst);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn point_vortex_far_field_is_biot_savart() {
+        // Γ = 2π at the origin induces unit-speed counter-clockwise flow at distance 1.
+        let (u, w) = induced_at(1.0, 0.0, &[0.0], &[0.0], &[2.0 * PI], 1e-16);
+        assert!((u - 0.0).abs() < 1e-12 && (w - 1.0).abs() < 1e-12);
+        let (u, w) = induced_at(0.0, 2.0, &[0.0], &[0.0], &[2.0 * PI], 1e-16);
+        assert!((u + 0.5).abs() < 1e-12 && w.abs() < 1e-12);
+    }
+
+    #[test]
+    fn pair_velocities_match_direct_sum_and_merging_conserves_circulation() {
+        let mut wake = Wake::with_capacity(16);
+        let pts = [
+            (0.0, 0.0, 1.0),
+            (0.3, 0.1, -0.5),
+            (1.0, -0.2, 0.7),
+            (5.0, 5.0, 0.2),
+            (5.1, 5.0, 0.3),
+            (-2.0, 1.0, 0.1),
+        ];
+        for &(x, z, g) in &pts {
+            wake.push(x, z, g, VortexKind::Tev);
+        }
+        let rc4 = 0.01f64.powi(4);
+        wake.compute_velocities(&[], &[], &[], rc4);
+        for (i, &(x, z, _)) in pts.iter().enumerate() {
+            let (mut u, mut w) = (0.0, 0.0);
+            for (j, &(xj, zj, gj)) in pts.iter().enumerate() {
+                if i != j {
+                    let (du, dw) = induced_at(x, z, &[xj], &[zj], &[gj], rc4);
+                    u += du;
+                    w += dw;
+                }
+            }
+            assert!((wake.u[i] - u).abs() < 1e-13 && (wake.w[i] - w).abs() < 1e-13);
+        }
+        let total = wake.total_circulation();
+        wake.amalgamate([0.0, 0.0], [0.0, 0.0], 1.0, 0.0, 1e9, 2);
+        assert!(wake.len() < pts.len());
+        assert!((wake.total_circulation() - total).abs() < 1e-14);
+        // the newest vortex is protected and still last
+        assert_eq!(wake.last_tev, Some(wake.len() - 1));
+        assert_eq!(wake.gamma_m2_s()[wake.len() - 1], 0.1);
+    }
+}

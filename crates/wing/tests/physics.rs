@@ -1,0 +1,435 @@
+//! Physics validation of the virtual wing (physics notes §4.4), noise-free.
+
+use flapssm_wing::aero::blade_element::{BladeElement, BladeGeometry};
+use flapssm_wing::aero::quasi_steady::{
+    QuasiSteadyParams, QuasiSteadySection, added_mass, centre_of_pressure_frac, dickinson_drag,
+    dickinson_lift, dickinson_normal, rotational_coefficient,
+};
+use flapssm_wing::aero::unsteady::{UnsteadyParams, UnsteadySection};
+use flapssm_wing::aero::{SectionGeometry, SectionKinematics, SectionModel, SectionModelFactory};
+use flapssm_wing::kinematics::{EulerState, WingKinematics};
+use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, PI};
+
+fn section() -> SectionGeometry {
+    SectionGeometry {
+        chord_m: 0.06,
+        pitch_axis_frac: 0.15,
+        radius_m: 0.178,
+        density_kg_m3: 800.0,
+    }
+}
+
+fn blade() -> BladeGeometry {
+    BladeGeometry {
+        span_m: 0.18,
+        chord_m: 0.06,
+        root_offset_m: 0.055,
+        pitch_axis_frac: 0.15,
+        density_kg_m3: 800.0,
+        sensor_radius_m: 0.055,
+    }
+}
+
+/// L1 with only the Wagner lag (LEV lag and inflow off).
+fn wagner_only() -> UnsteadyParams {
+    UnsteadyParams {
+        lev_lag: false,
+        inflow: false,
+        ..UnsteadyParams::default()
+    }
+}
+
+#[test]
+fn dickinson_coefficients_match_published_values() {
+    let d45 = 45f64.to_radians();
+    assert!((dickinson_lift(d45) - 1.805).abs() < 1e-3);
+    assert!((dickinson_drag(d45) - 1.704).abs() < 1e-3);
+    assert!((dickinson_normal(FRAC_PI_2) - 3.461).abs() < 1e-3);
+    assert!((centre_of_pressure_frac(FRAC_PI_4) - 0.255).abs() < 1e-3);
+    assert!((rotational_coefficient(0.15) - 1.885).abs() < 1e-3);
+    assert!((rotational_coefficient(0.25) - 1.571).abs() < 1e-3);
+}
+
+#[test]
+fn blade_element_integrals_are_exact() {
+    let be = BladeElement::new(blade(), 8, &QuasiSteadyParams::default()).unwrap();
+    let i2: f64 = be
+        .radii_m()
+        .iter()
+        .zip(be.weights_m())
+        .map(|(r, w)| w * r * r)
+        .sum();
+    let i3: f64 = be
+        .radii_m()
+        .iter()
+        .zip(be.weights_m())
+        .map(|(r, w)| w * r * r * r)
+        .sum();
+    let exact2 = (0.235f64.powi(3) - 0.055f64.powi(3)) / 3.0;
+    assert!((exact2 - 4.2705e-3).abs() < 1e-7);
+    assert!((i2 - exact2).abs() / exact2 < 1e-12);
+    let r_cp = i3 / i2;
+    let exact_cp = (0.235f64.powi(4) - 0.055f64.powi(4)) / 4.0 / exact2;
+    assert!((r_cp - exact_cp).abs() / exact_cp < 1e-12);
+    assert!((r_cp - 0.1780).abs() < 1e-4);
+}
+
+/// Steady translation at 45° AoA: blade-element F_x = ½ρc C_N* |v|² ∫r²dr and
+/// M_y = ½ρc C_N* |v|² ∫r²(r − r_s)dr (analytic), and 20 → 40 strips changes F by < 0.1 %.
+#[test]
+fn blade_element_translation_matches_analytic_and_converges() {
+    let state = EulerState {
+        angles_rad: [0.0, 0.0, -FRAC_PI_4],
+        rates_rad_s: [2.0, 0.0, 0.0],
+        accels_rad_s2: [0.0; 3],
+    };
+    let kin = WingKinematics::from_euler(&state);
+    let params = QuasiSteadyParams {
+        rotational: false,
+        added_mass: false,
+        ..Default::default()
+    };
+    let mut be = BladeElement::new(blade(), 6, &params).unwrap();
+    let f = be.step(&kin, 0.0);
+    let cn = flapssm_wing::aero::quasi_steady::plate_normal(FRAC_PI_4);
+    let q = 0.5 * 800.0 * 0.06 * 4.0;
+    let i2 = (0.235f64.powi(3) - 0.055f64.powi(3)) / 3.0;
+    let i3 = (0.235f64.powi(4) - 0.055f64.powi(4)) / 4.0;
+    // AoA = −45° here (v_x > 0), so the normal force is along −x.
+    assert!((f[0] + cn * q * i2).abs() < 1e-12, "{}", f[0]);
+    assert!((f[3] + 1e3 * cn * q * (i3 - 0.055 * i2)).abs() < 1e-9);
+    for params in [QuasiSteadyParams::default()] {
+        let state = EulerState {
+            angles_rad: [0.3, 0.2, -0.7],
+            rates_rad_s: [2.0, 0.7, 3.0],
+            accels_rad_s2: [5.0, -2.0, 9.0],
+        };
+        let kin = WingKinematics::from_euler(&state);
+        let f20 = BladeElement::new(blade(), 20, &params)
+            .unwrap()
+            .step(&kin, 0.0);
+        let f40 = BladeElement::new(blade(), 40, &params)
+            .unwrap()
+            .step(&kin, 0.0);
+        for i in 0..5 {
+            assert!(
+                (f20[i] - f40[i]).abs() <= 1e-3 * f40[i].abs(),
+                "channel {i}: {} vs {}",
+                f20[i],
+                f40[i]
+            );
+        }
+    }
+}
+
+#[test]
+fn added_mass_of_a_plunging_plate() {
+    let geom = SectionGeometry {
+        pitch_axis_frac: 0.3,
+        ..section()
+    };
+    for h_ddot in [-3.0, 0.5, 7.0] {
+        let kin = SectionKinematics {
+            normal_velocity_rate_m_s2: h_ddot,
+            ..Default::default()
+        };
+        let l = added_mass(&geom, &kin);
+        let exact = -PI / 4.0 * 800.0 * 0.06 * 0.06 * h_ddot;
+        assert!((l.normal_n_m - exact).abs() <= 1e-12 * exact.abs());
+    }
+    // In still fluid with zero circulation the L0 and L1 forces are the added mass alone, in
+    // phase with the acceleration (harmonic plunge, zero chordwise motion).
+    let mut l1 = UnsteadySection::new(section(), UnsteadyParams::default());
+    let l0 = QuasiSteadySection::new(section(), QuasiSteadyParams::default());
+    let (omega, amp) = (2.0 * PI, 0.01);
+    let dt = 1e-3;
+    for k in 0..2000 {
+        let t = k as f64 * dt;
+        let kin = SectionKinematics {
+            normal_velocity_m_s: 0.0,
+            normal_velocity_rate_m_s2: -amp * omega * omega * (omega * t).sin(),
+            ..Default::default()
+        };
+        let exact = -PI / 4.0 * 800.0 * 0.0036 * kin.normal_velocity_rate_m_s2;
+        assert!((l0.loads(&kin).normal_n_m - exact).abs() < 1e-12);
+        assert!((l1.step(&kin, dt).normal_n_m - exact).abs() < 1e-12);
+    }
+}
+
+#[test]
+fn zero_motion_gives_zero_load() {
+    let kin = WingKinematics::from_euler(&EulerState {
+        angles_rad: [0.4, -0.2, 1.0],
+        ..Default::default()
+    });
+    for factory in [
+        &QuasiSteadyParams::default() as &dyn SectionModelFactory,
+        &UnsteadyParams::default(),
+    ] {
+        let mut be = BladeElement::new(blade(), 10, factory).unwrap();
+        for _ in 0..50 {
+            assert_eq!(be.step(&kin, 0.004), [0.0; 5]);
+        }
+    }
+}
+
+/// Impulsive start at 3°: the attached share cos²α of the translational force follows the
+/// exact Wagner function φ(s) of the physics notes' table (the LEV share, sin²α, is
+/// instantaneous when the LEV lag is off), within 0.015.
+#[test]
+fn wagner_step_response() {
+    let table = [
+        (1.0, 0.601),
+        (2.0, 0.669),
+        (4.0, 0.758),
+        (10.0, 0.875),
+        (20.0, 0.937),
+    ];
+    let (u, c) = (0.3, 0.06);
+    let aoa = 3f64.to_radians();
+    let kin = SectionKinematics {
+        normal_velocity_m_s: -u * aoa.sin(),
+        chord_velocity_m_s: u * aoa.cos(),
+        ..Default::default()
+    };
+    let mut l1 = UnsteadySection::new(section(), wagner_only());
+    let steady = QuasiSteadySection::new(section(), QuasiSteadyParams::default())
+        .loads(&kin)
+        .normal_n_m;
+    let ds = 0.01;
+    let dt = ds * c / (2.0 * u);
+    let att = aoa.cos().powi(2);
+    let expect = |phi: f64| att * phi + (1.0 - att);
+    let first = l1.step(&kin, 0.0).normal_n_m / steady;
+    assert!((first - expect(0.5)).abs() < 1e-12);
+    let mut s = 0.0;
+    let mut k = 0;
+    while k < table.len() {
+        let ratio = l1.step(&kin, dt).normal_n_m / steady;
+        s += ds;
+        if (s - table[k].0).abs() < 1e-6 {
+            assert!(
+                (ratio - expect(table[k].1)).abs() < 0.015,
+                "s = {s}: {ratio} vs {}",
+                table[k].1
+            );
+            k += 1;
+        }
+    }
+}
+
+/// Small-amplitude harmonic plunge at constant speed: the circulatory normal force relative to
+/// its quasi-steady value must follow Theodorsen's C(k) (2 %, 2°).
+#[test]
+fn theodorsen_function() {
+    let exact = [
+        (0.1, 0.8319, -0.1723),
+        (0.5, 0.5979, -0.1507),
+        (1.0, 0.5394, -0.1003),
+    ];
+    let (u, c) = (0.3, 0.06);
+    let params = UnsteadyParams {
+        quasi_steady: QuasiSteadyParams {
+            added_mass: false,
+            ..Default::default()
+        },
+        ..wagner_only()
+    };
+    for (k, re, im) in exact {
+        let omega = 2.0 * u * k / c;
+        let period = 2.0 * PI / omega;
+        let dt = period / 400.0;
+        let mut l1 = UnsteadySection::new(section(), params);
+        let qs = QuasiSteadySection::new(section(), params.quasi_steady);
+        let (mut a_l1, mut a_qs) = ([0.0f64; 2], [0.0f64; 2]);
+        let n_steps = 400 * 60;
+        for i in 0..=n_steps {
+            let t = i as f64 * dt;
+            let kin = SectionKinematics {
+                normal_velocity_m_s: 0.002 * u * (omega * t).sin(),
+                chord_velocity_m_s: u,
+                ..Default::default()
+            };
+            let y = l1.step(&kin, if i == 0 { 0.0 } else { dt }).normal_n_m;
+            let y_qs = qs.loads(&kin).normal_n_m;
+            if i >= n_steps - 400 * 10 && i < n_steps {
+                let (s, co) = (omega * t).sin_cos();
+                a_l1[0] += y * s;
+                a_l1[1] += y * co;
+                a_qs[0] += y_qs * s;
+                a_qs[1] += y_qs * co;
+            }
+        }
+        let amp = a_l1[0].hypot(a_l1[1]) / a_qs[0].hypot(a_qs[1]);
+        let d = a_l1[1].atan2(a_l1[0]) - a_qs[1].atan2(a_qs[0]);
+        let phase = d.sin().atan2(d.cos());
+        let exact_amp = f64::hypot(re, im);
+        let exact_phase = f64::atan2(im, re);
+        assert!(
+            (amp / exact_amp - 1.0).abs() < 0.02,
+            "k = {k}: |C| {amp} vs {exact_amp}"
+        );
+        assert!(
+            (phase - exact_phase).to_degrees().abs() < 2.0,
+            "k = {k}: arg C {phase} vs {exact_phase}"
+        );
+    }
+}
+
+use flapssm_wing::trajectories::{Family, GeneratorConfig};
+use flapssm_wing::virtual_wing::{Fidelity, VirtualWing, VirtualWingConfig};
+
+fn wing(fidelity: Fidelity) -> VirtualWing {
+    VirtualWing::new(&VirtualWingConfig {
+        fidelity,
+        ..VirtualWingConfig::default()
+    })
+    .unwrap()
+}
+
+fn generated_states(dt_s: f64, n: usize) -> Vec<EulerState> {
+    let spec = GeneratorConfig::default()
+        .generate_one(3, Family::FigureEight)
+        .unwrap();
+    (0..n).map(|k| spec.euler_state(k as f64 * dt_s)).collect()
+}
+
+/// (φ, ψ, α) → (−φ, ψ, −α) reflects the wing frame in x_w: F_x, M_y, M_z change sign,
+/// F_y and M_x do not. Exact up to rounding for L0 and L1.
+#[test]
+fn mirror_symmetry() {
+    let dt = 0.004;
+    let states = generated_states(dt, 2000);
+    let mirrored: Vec<EulerState> = states
+        .iter()
+        .map(|s| {
+            let m = |v: [f64; 3]| [-v[0], v[1], -v[2]];
+            EulerState {
+                angles_rad: m(s.angles_rad),
+                rates_rad_s: m(s.rates_rad_s),
+                accels_rad_s2: m(s.accels_rad_s2),
+            }
+        })
+        .collect();
+    for fidelity in [Fidelity::L0, Fidelity::L1] {
+        let mut w = wing(fidelity);
+        let mut a = vec![[0.0; 5]; states.len()];
+        let mut b = a.clone();
+        w.aero_loads_into(&states, dt, &mut a);
+        w.aero_loads_into(&mirrored, dt, &mut b);
+        let scale: Vec<f64> = (0..5)
+            .map(|c| a.iter().map(|y| y[c].abs()).fold(0.0, f64::max))
+            .collect();
+        let sign = [-1.0, 1.0, 1.0, -1.0, -1.0];
+        for (ya, yb) in a.iter().zip(&b) {
+            for c in 0..5 {
+                assert!(
+                    (yb[c] - sign[c] * ya[c]).abs() <= 1e-12 * scale[c],
+                    "{fidelity:?} channel {c}"
+                );
+            }
+        }
+    }
+}
+
+/// Doubling the flapping frequency multiplies every load by 4 (coefficients unchanged).
+#[test]
+fn time_scaling_invariance() {
+    let spec = GeneratorConfig::default()
+        .generate_one(5, Family::Oval)
+        .unwrap();
+    let dt = 0.004;
+    let n = 2500;
+    let slow: Vec<EulerState> = (0..n).map(|k| spec.euler_state(k as f64 * dt)).collect();
+    let fast: Vec<EulerState> = slow
+        .iter()
+        .map(|s| EulerState {
+            angles_rad: s.angles_rad,
+            rates_rad_s: s.rates_rad_s.map(|v| 2.0 * v),
+            accels_rad_s2: s.accels_rad_s2.map(|v| 4.0 * v),
+        })
+        .collect();
+    for fidelity in [Fidelity::L0, Fidelity::L1] {
+        let mut w = wing(fidelity);
+        let mut a = vec![[0.0; 5]; n];
+        let mut b = a.clone();
+        w.aero_loads_into(&slow, dt, &mut a);
+        w.aero_loads_into(&fast, dt / 2.0, &mut b);
+        for c in 0..5 {
+            let scale = a.iter().map(|y| y[c].abs()).fold(0.0, f64::max);
+            for (ya, yb) in a.iter().zip(&b) {
+                assert!(
+                    (yb[c] / 4.0 - ya[c]).abs() <= 1e-9 * scale,
+                    "{fidelity:?} channel {c}"
+                );
+            }
+        }
+    }
+}
+
+/// Robofly-like hovering: φ = 80° sin(2πft), ψ = 0, symmetric rotation with α = ∓45° at
+/// mid-stroke (AoA = 45°). Robofly convention for the mean lift coefficient (Sane & Dickinson
+/// 2001): C̄_L = L̄ / (½ρc ∫r²dr · mean φ̇²) in [1.0, 1.8]; dataset convention (½ρSU_ref²,
+/// ½ρc̄SU_ref²) for the instantaneous coefficients: inside the published plot ranges
+/// C_F ∈ [−4, 7], C_M ∈ [−11, 13]; mid-stroke normal coefficient (Robofly convention) near
+/// C_N ≈ 2.5.
+#[test]
+fn hovering_sanity() {
+    let (f, amp, a_pitch, k) = (0.3, 80f64.to_radians(), FRAC_PI_4, 3.0);
+    let w = 2.0 * PI * f;
+    let state = |t: f64| {
+        let x = w * t;
+        let u = k * x.cos();
+        let (u1, u2) = (-k * x.sin() * w, -k * x.cos() * w * w);
+        let g = u.tanh();
+        let g1 = (1.0 - g * g) * u1;
+        let g2 = (1.0 - g * g) * u2 - 2.0 * g * (1.0 - g * g) * u1 * u1;
+        let s = -a_pitch / k.tanh();
+        EulerState {
+            angles_rad: [amp * x.sin(), 0.0, s * g],
+            rates_rad_s: [amp * w * x.cos(), 0.0, s * g1],
+            accels_rad_s2: [-amp * w * w * x.sin(), 0.0, s * g2],
+        }
+    };
+    let dt = 1.0 / f / 800.0;
+    let per_cycle = 800;
+    let n = 6 * per_cycle;
+    let states: Vec<EulerState> = (0..n).map(|i| state(i as f64 * dt)).collect();
+    let u_ref = 0.235 * 4.0 * amp * f;
+    let q_s = 0.5 * 800.0 * 0.0108 * u_ref * u_ref;
+    let i2 = (0.235f64.powi(3) - 0.055f64.powi(3)) / 3.0;
+    let q_robofly = |phi_dot2: f64| 0.5 * 800.0 * 0.06 * i2 * phi_dot2;
+    for fidelity in [Fidelity::L0, Fidelity::L1] {
+        let mut wg = wing(fidelity);
+        let mut y = vec![[0.0; 5]; n];
+        wg.aero_loads_into(&states, dt, &mut y);
+        let (mut lift, mut phi_dot2) = (0.0, 0.0);
+        for i in n - per_cycle..n {
+            let r = flapssm_wing::kinematics::rotation_global_from_wing(&states[i].angles_rad);
+            lift += r[1][0] * y[i][0] + r[1][1] * y[i][1];
+            phi_dot2 += states[i].rates_rad_s[0].powi(2);
+            let cf = [y[i][0] / q_s, y[i][1] / q_s];
+            let cm = [2, 3, 4].map(|c| y[i][c] / (1e3 * q_s * 0.06));
+            assert!(
+                cf.iter().all(|v| (-4.0..=7.0).contains(v)),
+                "{fidelity:?} C_F {cf:?}"
+            );
+            assert!(
+                cm.iter().all(|v| (-11.0..=13.0).contains(v)),
+                "{fidelity:?} C_M {cm:?}"
+            );
+        }
+        let cl = lift / per_cycle as f64 / q_robofly(phi_dot2 / per_cycle as f64);
+        let mid = n - per_cycle;
+        let cn_mid = (y[mid][0] / q_robofly(states[mid].rates_rad_s[0].powi(2))).abs();
+        eprintln!("{fidelity:?}: mean C_L = {cl:.3}, mid-stroke C_N = {cn_mid:.3}");
+        assert!(
+            (1.0..=1.8).contains(&cl),
+            "{fidelity:?}: cycle-mean C_L = {cl}"
+        );
+        assert!(
+            (1.8..=2.8).contains(&cn_mid),
+            "{fidelity:?}: mid-stroke C_N = {cn_mid}"
+        );
+    }
+}

@@ -1,0 +1,456 @@
+//! Checks of the L2 vortex method against analytic values (Wagner, Theodorsen), the canonical
+//! LDVM pitch-up, conservation laws and invariances.
+
+use std::f64::consts::PI;
+
+use flapssm_wing::vortex::{Ldvm, LdvmParams, PlateState, SectionLoads, VortexKind};
+
+/// A plate translating in −X at speed `u`, with chord angle −alpha (nose up), plunge h(t) along
+/// +Z and pivot at `pivot_frac`.
+#[derive(Clone, Copy)]
+struct Motion {
+    u: f64,
+    alpha: fn(f64) -> (f64, f64),
+    h: fn(f64) -> (f64, f64),
+}
+
+fn plate_at(m: &Motion, t: f64) -> PlateState {
+    let (a, ad) = (m.alpha)(t);
+    let (h, hd) = (m.h)(t);
+    PlateState {
+        pivot_m: [-m.u * t, h],
+        pivot_vel_m_s: [-m.u, hd],
+        angle_rad: -a,
+        angle_rate_rad_s: -ad,
+    }
+}
+
+/// Lift (+Z) and drag (+X, with the flow) per unit span from plate-axis loads at chord angle ϑ.
+fn lift_drag(l: &SectionLoads, angle_rad: f64) -> (f64, f64) {
+    let (s, c) = angle_rad.sin_cos();
+    let (tx, tz, nx, nz) = (c, s, -s, c);
+    let fx = l.normal_n_m * nx + l.chord_n_m * tx;
+    let fz = l.normal_n_m * nz + l.chord_n_m * tz;
+    (fz, fx)
+}
+
+/// Runs `n` steps at t_k = k·dt; returns (t, plate, loads) per step.
+fn run(
+    params: LdvmParams,
+    m: &Motion,
+    dt: f64,
+    n: usize,
+) -> (Ldvm, Vec<(f64, PlateState, SectionLoads)>) {
+    let mut ldvm = Ldvm::new(params).unwrap();
+    let mut out = Vec::with_capacity(n);
+    for k in 0..n {
+        let t = k as f64 * dt;
+        let p = plate_at(m, t);
+        let l = ldvm.step(&p, dt).unwrap();
+        out.push((t, p, l));
+    }
+    (ldvm, out)
+}
+
+fn zero(_: f64) -> (f64, f64) {
+    (0.0, 0.0)
+}
+
+/// Wagner: impulsive start at α = 4°, LEV off; C_L(s)/(2π sin α) against the exact φ(s).
+#[test]
+fn wagner_step_response() {
+    fn alpha(_: f64) -> (f64, f64) {
+        (4f64.to_radians(), 0.0)
+    }
+    let (c, u, rho) = (1.0, 1.0, 1.0);
+    let m = Motion { u, alpha, h: zero };
+    let dt = 0.01;
+    let n = (20.5 / (2.0 * u / c) / dt) as usize + 2;
+    let mut p = LdvmParams::inviscid(c, u, n + 10);
+    p.rho_kg_m3 = rho;
+    p.pivot_frac = 0.25;
+    p.core_radius_frac = 0.005;
+    let (_, out) = run(p, &m, dt, n);
+    let cl_inf = 2.0 * PI * 4f64.to_radians().sin();
+    let table = [
+        (1.0, 0.601),
+        (2.0, 0.669),
+        (4.0, 0.758),
+        (10.0, 0.875),
+        (20.0, 0.937),
+    ];
+    for (s, phi) in table {
+        let t = s * c / (2.0 * u);
+        let k = (t / dt).floor() as usize;
+        let frac = t / dt - k as f64;
+        let cl = |i: usize| lift_drag(&out[i].2, out[i].1.angle_rad).0 / (0.5 * rho * u * u * c);
+        let ratio = ((1.0 - frac) * cl(k) + frac * cl(k + 1)) / cl_inf;
+        println!("s = {s}: LDVM {ratio:.4}, exact {phi}");
+        assert!((ratio - phi).abs() < 0.03, "s = {s}: {ratio} vs {phi}");
+    }
+}
+
+/// Complex amplitude (a, b) of x ≈ a cos ωt + b sin ωt + d, least squares.
+fn harmonic_fit(t: &[f64], x: &[f64], w: f64) -> (f64, f64) {
+    let mut ata = [[0.0; 3]; 3];
+    let mut atb = [0.0; 3];
+    for (&ti, &xi) in t.iter().zip(x) {
+        let r = [(w * ti).cos(), (w * ti).sin(), 1.0];
+        for i in 0..3 {
+            for j in 0..3 {
+                ata[i][j] += r[i] * r[j];
+            }
+            atb[i] += r[i] * xi;
+        }
+    }
+    // Gaussian elimination, 3×3
+    for i in 0..3 {
+        for k in (i + 1)..3 {
+            let f = ata[k][i] / ata[i][i];
+            for j in 0..3 {
+                ata[k][j] -= f * ata[i][j];
+            }
+            atb[k] -= f * atb[i];
+        }
+    }
+    let mut s = [0.0; 3];
+    for i in (0..3).rev() {
+        let mut v = atb[i];
+        for j in (i + 1)..3 {
+            v -= ata[i][j] * s[j];
+        }
+        s[i] = v / ata[i][i];
+    }
+    (s[0], s[1])
+}
+
+/// Theodorsen: small-amplitude harmonic plunge; circulatory lift L − L_nc against C(k)·L_qs.
+#[test]
+fn theodorsen_harmonic_plunge() {
+    let (c, u, rho) = (1.0, 1.0, 1.0);
+    let cases: [(f64, f64, f64); 3] = [
+        (0.1, 0.8319, -0.1723),
+        (0.5, 0.5979, -0.1507),
+        (1.0, 0.5394, -0.1003),
+    ];
+    for (k, cre, cim) in cases {
+        let w = 2.0 * k * u / c;
+        // plunge amplitude giving a 2° induced angle
+        let h0 = 2f64.to_radians() * u / w;
+        let period = 2.0 * PI / w;
+        let n_cycles = 6.0;
+        let dt = (period / 240.0).min(0.05);
+        let n = (n_cycles * period / dt) as usize;
+        let mut p = LdvmParams::inviscid(c, u, 600);
+        p.rho_kg_m3 = rho;
+        p.core_radius_frac = 0.005;
+        p.merge = Some(flapssm_wing::vortex::MergeParams {
+            d0_chords: 1.0,
+            v0: 1e-7,
+            interval_steps: 5,
+        });
+        let mut ldvm = Ldvm::new(p).unwrap();
+        let (mut ts, mut lc, mut lq) = (vec![], vec![], vec![]);
+        for i in 0..n {
+            let t = i as f64 * dt;
+            let (hd, hdd) = (h0 * w * (w * t).cos(), -h0 * w * w * (w * t).sin());
+            let plate = PlateState {
+                pivot_m: [-u * t, h0 * (w * t).sin()],
+                pivot_vel_m_s: [-u, hd],
+                angle_rad: 0.0,
+                angle_rate_rad_s: 0.0,
+            };
+            let l = ldvm.step(&plate, dt).unwrap();
+            if t > (n_cycles - 3.0) * period {
+                let l_nc = -rho * PI * c * c / 4.0 * hdd;
+                ts.push(t);
+                lc.push(l.normal_n_m - l_nc);
+                lq.push(-rho * PI * u * c * hd);
+            }
+        }
+        let (ac, bc) = harmonic_fit(&ts, &lc, w);
+        let (aq, bq) = harmonic_fit(&ts, &lq, w);
+        // phasors: x = Re[(a − i b) e^{iωt}]
+        let (zr, zi) = (ac, -bc);
+        let (qr, qi) = (aq, -bq);
+        let den = qr * qr + qi * qi;
+        let (cr, ci) = ((zr * qr + zi * qi) / den, (zi * qr - zr * qi) / den);
+        let (mag, ph) = (cr.hypot(ci), ci.atan2(cr).to_degrees());
+        let (mag_t, ph_t) = (cre.hypot(cim), f64::atan2(cim, cre).to_degrees());
+        println!(
+            "k = {k}: |C| {mag:.4} (exact {mag_t:.4}), phase {ph:.2}° (exact {ph_t:.2}°), {} vortices",
+            ldvm.wake().len()
+        );
+        assert!(
+            (mag / mag_t - 1.0).abs() < 0.05,
+            "k = {k}: |C| = {mag} vs {mag_t}"
+        );
+        assert!((ph - ph_t).abs() < 5.0, "k = {k}: phase {ph} vs {ph_t}");
+    }
+}
+
+/// Eldredge canonical pitch-up (45°, K = 0.4, LE pivot, LESP_crit = 0.11, smoothing σ = 0.8).
+fn eldredge(t: f64) -> (f64, f64) {
+    let (amp, k, sigma) = (PI / 4.0, 0.4, 0.8);
+    let a = PI * PI * k / (2.0 * amp * (1.0 - sigma));
+    let (t1, t2) = (1.0, 1.0 + amp / (2.0 * k));
+    let lc = |x: f64| x.abs() + (1.0 + (-2.0 * x.abs()).exp()).ln() - 2f64.ln(); // ln cosh x
+    let al = 0.5 * amp * (1.0 + (lc(a * (t - t1)) - lc(a * (t - t2))) / (a * (t2 - t1)));
+    let ad = 0.5 * amp * ((a * (t - t1)).tanh() - (a * (t - t2)).tanh()) / (t2 - t1);
+    (al, ad)
+}
+
+#[test]
+fn eldredge_pitch_up_sheds_lev_at_lesp_crit_and_peaks_during_ramp() {
+    let (c, u, rho) = (1.0, 1.0, 1.0);
+    let m = Motion {
+        u,
+        alpha: eldredge,
+        h: zero,
+    };
+    let p = LdvmParams {
+        chord_m: c,
+        u_ref_m_s: u,
+        rho_kg_m3: rho,
+        pivot_frac: 0.0,
+        lesp_crit: Some(0.11),
+        lev_decay_chords: None,
+        tev_decay_chords: None,
+        far_field_chords: None,
+        max_vortices: 400,
+        ..LdvmParams::default()
+    };
+    let dt = 0.015;
+    let mut ldvm = Ldvm::new(p).unwrap();
+    let (mut onset, mut peak) = (None, (0.0f64, 0.0));
+    for k in 0..((5.0 / dt) as usize) {
+        let t = k as f64 * dt;
+        let plate = plate_at(&m, t);
+        let l = ldvm.step(&plate, dt).unwrap();
+        let d = *ldvm.diagnostics();
+        if onset.is_none() {
+            if d.lev_m2_s != 0.0 {
+                assert!(
+                    d.lesp_unshed.abs() > 0.11,
+                    "LEV shed at t = {t} with |A0| = {}",
+                    d.lesp_unshed
+                );
+                assert!(
+                    (d.lesp.abs() - 0.11).abs() < 1e-9,
+                    "A0 after shedding = {}",
+                    d.lesp
+                );
+                onset = Some((t, (m.alpha)(t).0.to_degrees()));
+            } else {
+                assert!(
+                    d.lesp.abs() <= 0.11 + 1e-12,
+                    "no LEV at t = {t} although |A0| = {}",
+                    d.lesp
+                );
+            }
+        }
+        let cl = lift_drag(&l, plate.angle_rad).0 / (0.5 * rho * u * u * c);
+        if (k % 8 == 0 || (t > 1.0 && t < 1.2)) && std::env::var("DBG").is_ok() {
+            println!(
+                "t {t:.3} a {:.1} cl {cl:.3} lesp {:.3} n {} tev {:.4} lev {:.4} B {:?} N {:.3} T {:.3}",
+                (m.alpha)(t).0.to_degrees(),
+                d.lesp,
+                d.n_vortices,
+                d.tev_m2_s,
+                d.lev_m2_s,
+                d.fourier_m_s,
+                l.normal_n_m,
+                l.chord_n_m
+            );
+        }
+        if k > 0 && cl > peak.0 {
+            peak = (cl, t);
+        }
+    }
+    let (t_on, a_on) = onset.expect("the LEV must be shed");
+    println!(
+        "LEV onset t* = {t_on:.3} (α = {a_on:.1}°), peak C_L = {:.3} at t* = {:.3}",
+        peak.0, peak.1
+    );
+    let t2 = 1.0 + PI / 4.0 / 0.8;
+    assert!(
+        t_on > 1.0 && t_on < t2,
+        "LEV onset at t* = {t_on} is outside the ramp"
+    );
+    assert!((3.0..=5.0).contains(&peak.0), "peak C_L = {}", peak.0);
+    assert!(peak.1 > 1.0 && peak.1 < t2 + 0.2, "peak at t* = {}", peak.1);
+}
+
+/// 2-D hovering: surge ±A along X with the LE leading, 45° geometric AoA at mid-stroke, a 2ω
+/// plunge. Returns per-step loads, plate states and times.
+struct Hover {
+    c: f64,
+    a: f64,
+    w: f64,
+    mirror: bool,
+}
+
+impl Hover {
+    fn plate(&self, t: f64) -> PlateState {
+        let (c, a, w) = (self.c, self.a, self.w);
+        let s = if self.mirror { -1.0 } else { 1.0 };
+        let th = PI / 2.0 - PI / 4.0 * (w * t).sin();
+        let thd = -PI / 4.0 * w * (w * t).cos();
+        PlateState {
+            pivot_m: [a * (w * t).cos(), s * 0.5 * c * (2.0 * w * t).sin()],
+            pivot_vel_m_s: [-a * w * (w * t).sin(), s * c * w * (2.0 * w * t).cos()],
+            angle_rad: s * th,
+            angle_rate_rad_s: s * thd,
+        }
+    }
+
+    fn u_ref(&self) -> f64 {
+        2.0 / PI * self.a * self.w
+    }
+
+    fn run(&self, p: LdvmParams, cycles: f64, steps_per_cycle: usize) -> (Ldvm, Vec<SectionLoads>) {
+        let dt = 2.0 * PI / self.w / steps_per_cycle as f64;
+        let mut ldvm = Ldvm::new(LdvmParams {
+            chord_m: self.c,
+            u_ref_m_s: self.u_ref(),
+            ..p
+        })
+        .unwrap();
+        let n = (cycles * steps_per_cycle as f64) as usize;
+        let loads = (0..n)
+            .map(|k| ldvm.step(&self.plate(k as f64 * dt), dt).unwrap())
+            .collect();
+        (ldvm, loads)
+    }
+}
+
+fn max_abs(x: impl Iterator<Item = f64>) -> f64 {
+    x.fold(0.0, |m, v| m.max(v.abs()))
+}
+
+#[test]
+fn hover_mirror_symmetry() {
+    let h = Hover {
+        c: 0.06,
+        a: 0.24,
+        w: 1.25,
+        mirror: false,
+    };
+    let hm = Hover { mirror: true, ..h };
+    let p = LdvmParams::default();
+    let (ldvm, a) = h.run(p, 2.0, 600);
+    let (_, b) = hm.run(p, 2.0, 600);
+    let n_max = max_abs(a.iter().map(|l| l.normal_n_m));
+    let m_max = max_abs(a.iter().map(|l| l.moment_pivot_n));
+    let t_max = max_abs(a.iter().map(|l| l.chord_n_m));
+    let dn = max_abs(a.iter().zip(&b).map(|(x, y)| x.normal_n_m + y.normal_n_m));
+    let dm = max_abs(
+        a.iter()
+            .zip(&b)
+            .map(|(x, y)| x.moment_pivot_n + y.moment_pivot_n),
+    );
+    let dt = max_abs(a.iter().zip(&b).map(|(x, y)| x.chord_n_m - y.chord_n_m));
+    println!(
+        "mirror: max N {n_max:.4} N/m, rel. diffs N {:.2e}, T {:.2e}, M {:.2e}; {} vortices",
+        dn / n_max,
+        dt / t_max,
+        dm / m_max,
+        ldvm.wake().len()
+    );
+    assert!(n_max > 0.05 && ldvm.wake().kinds().contains(&VortexKind::Lev));
+    assert!(dn < 0.01 * n_max && dm < 0.01 * m_max && dt < 0.01 * t_max);
+}
+
+#[test]
+fn zero_motion_gives_zero_load() {
+    let mut ldvm = Ldvm::new(LdvmParams::default()).unwrap();
+    let plate = PlateState {
+        pivot_m: [0.3, -0.1],
+        pivot_vel_m_s: [0.0, 0.0],
+        angle_rad: 1.0,
+        angle_rate_rad_s: 0.0,
+    };
+    for _ in 0..200 {
+        let l = ldvm.step(&plate, 0.004).unwrap();
+        assert_eq!(
+            (l.normal_n_m, l.chord_n_m, l.moment_pivot_n),
+            (0.0, 0.0, 0.0)
+        );
+    }
+    assert_eq!(ldvm.wake().total_circulation(), 0.0);
+}
+
+/// Doubling the frequency (and halving dt) leaves the coefficients F/(½ρU_ref²c) unchanged.
+#[test]
+fn time_scaling_invariance() {
+    let h1 = Hover {
+        c: 0.06,
+        a: 0.24,
+        w: 1.25,
+        mirror: false,
+    };
+    let h2 = Hover { w: 2.5, ..h1 };
+    let p = LdvmParams::default();
+    let (_, a) = h1.run(p, 1.5, 500);
+    let (_, b) = h2.run(p, 1.5, 500);
+    let q1 = 0.5 * p.rho_kg_m3 * h1.u_ref().powi(2) * h1.c;
+    let q2 = 0.5 * p.rho_kg_m3 * h2.u_ref().powi(2) * h2.c;
+    let cn_max = max_abs(a.iter().map(|l| l.normal_n_m / q1));
+    let d = max_abs(
+        a.iter()
+            .zip(&b)
+            .map(|(x, y)| x.normal_n_m / q1 - y.normal_n_m / q2),
+    );
+    let dm = max_abs(
+        a.iter()
+            .zip(&b)
+            .map(|(x, y)| (x.moment_pivot_n / q1 - y.moment_pivot_n / q2) / h1.c),
+    );
+    println!("time scaling: max C_N {cn_max:.3}, max |ΔC_N| {d:.2e}, max |ΔC_M| {dm:.2e}");
+    assert!(cn_max > 0.5);
+    assert!(d < 0.01 * cn_max && dm < 0.01 * cn_max);
+}
+
+/// Kelvin: bound (sum of the element circulations) + free circulation stays zero through
+/// shedding, LEV shedding and amalgamation when nothing decays or is deleted.
+#[test]
+fn kelvin_total_circulation_is_zero_without_decay() {
+    let h = Hover {
+        c: 0.06,
+        a: 0.24,
+        w: 1.25,
+        mirror: false,
+    };
+    let p = LdvmParams {
+        lev_decay_chords: None,
+        tev_decay_chords: None,
+        far_field_chords: None,
+        max_vortices: 120,
+        ..LdvmParams::default()
+    };
+    let mut ldvm = Ldvm::new(LdvmParams {
+        chord_m: h.c,
+        u_ref_m_s: h.u_ref(),
+        ..p
+    })
+    .unwrap();
+    let dt = 2.0 * PI / h.w / 400.0;
+    let (mut worst, mut g_max, mut n_max, mut levs) = (0.0f64, 0.0f64, 0, 0);
+    for k in 0..800 {
+        ldvm.step(&h.plate(k as f64 * dt), dt).unwrap();
+        let bound: f64 = ldvm.bound_elements().1.iter().sum();
+        let free = ldvm.wake().total_circulation();
+        worst = worst.max((bound + free).abs());
+        g_max = g_max.max(bound.abs());
+        n_max = n_max.max(ldvm.wake().len());
+        levs += (ldvm.diagnostics().lev_m2_s != 0.0) as usize;
+    }
+    println!(
+        "Kelvin: max |Γ_total| {worst:.2e} (max |Γ_bound| {g_max:.2e}), {levs} LEV steps, ≤ {n_max} vortices"
+    );
+    assert!(
+        levs > 0 && n_max >= 95,
+        "LEV shedding and amalgamation must both be exercised"
+    );
+    assert!(worst < 1e-12 * g_max.max(1e-300) * 100.0);
+}
