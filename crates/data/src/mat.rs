@@ -827,7 +827,7 @@ mod tests {
             }
         };
         let mut body = Vec::new();
-        let mut sub = |body: &mut Vec<u8>, ty: u32, payload: &[u8]| {
+        let sub = |body: &mut Vec<u8>, ty: u32, payload: &[u8]| {
             body.extend_from_slice(&w32(ty));
             body.extend_from_slice(&w32(payload.len() as u32));
             body.extend_from_slice(payload);

@@ -323,8 +323,8 @@ mod tests {
             assert!((centre[j][1] + centre[4 - j][1]).abs() < 1e-14);
         }
         // First derivative: (−2, −1, 0, 1, 2)/10 per sample.
-        for j in 0..5 {
-            assert!((centre[j][1] - (j as f64 - 2.0) / 10.0).abs() < 1e-14);
+        for (j, w) in centre.iter().enumerate() {
+            assert!((w[1] - (j as f64 - 2.0) / 10.0).abs() < 1e-14);
         }
     }
 

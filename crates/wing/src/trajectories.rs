@@ -843,12 +843,16 @@ mod tests {
     }
 
     fn sample_series() -> (FourierSeries, FourierSeries) {
-        let mut a = FourierSeries::default();
-        a.offset_rad = 0.3;
+        let mut a = FourierSeries {
+            offset_rad: 0.3,
+            ..FourierSeries::default()
+        };
         a.add_sin(1, 0.7, 0.2);
         a.add_cos(3, -0.4, 1.1);
-        let mut b = FourierSeries::default();
-        b.offset_rad = -0.2;
+        let mut b = FourierSeries {
+            offset_rad: -0.2,
+            ..FourierSeries::default()
+        };
         b.add_cos(2, 0.5, -0.7);
         b.add_sin(1, 0.25, 2.0);
         (a, b)

@@ -203,6 +203,23 @@ fn median(mut v: Vec<f64>) -> f64 {
 }
 
 #[test]
+fn diag_aoa() {
+    let (ds, _) = dataset_with(Fidelity::L0, Default::default(), GeneratorConfig::default());
+    let (mut n, mut te, mut w, mut wte) = (0.0, 0.0, 0.0, 0.0);
+    for t in &ds.trajectories {
+        for u in &t.inputs[100..] {
+            n += 1.0;
+            w += u[1] * u[1];
+            if u[0].abs() > std::f64::consts::FRAC_PI_2 {
+                te += 1.0;
+                wte += u[1] * u[1];
+            }
+        }
+    }
+    eprintln!("TE-first fraction {:.3}, |v|^2-weighted {:.3}", te / n, wte / w);
+}
+
+#[test]
 fn diag_variants() {
     use flapssm_wing::aero::quasi_steady::QuasiSteadyParams;
     use flapssm_wing::aero::unsteady::UnsteadyParams;

@@ -144,11 +144,7 @@ fn theodorsen_harmonic_plunge() {
         let mut p = LdvmParams::inviscid(c, u, 600);
         p.rho_kg_m3 = rho;
         p.core_radius_frac = 0.005;
-        p.merge = Some(flapssm_wing::vortex::MergeParams {
-            d0_chords: 1.0,
-            v0: 1e-7,
-            interval_steps: 5,
-        });
+        p.merge = Some(flapssm_wing::vortex::MergeParams { v0: 1e-7, ..Default::default() });
         let mut ldvm = Ldvm::new(p).unwrap();
         let (mut ts, mut lc, mut lq) = (vec![], vec![], vec![]);
         for i in 0..n {
@@ -453,4 +449,19 @@ fn kelvin_total_circulation_is_zero_without_decay() {
         "LEV shedding and amalgamation must both be exercised"
     );
     assert!(worst < 1e-12 * g_max.max(1e-300) * 100.0);
+}
+
+#[test]
+fn debug_instab() {
+    fn alpha(t: f64) -> (f64, f64) {
+        (1e-9 * (t * 3.0).sin(), 0.0)
+    }
+    for (dt, rc, mer) in [(0.015, 0.02, true), (0.015, 0.02, false), (0.015, 0.005, true), (0.005, 0.02, true), (0.05, 0.02, true)] {
+        let m = Motion { u: 1.0, alpha, h: zero };
+        let mut p = LdvmParams { chord_m: 1.0, u_ref_m_s: 1.0, pivot_frac: 0.0, core_radius_frac: rc, max_vortices: 400, lev_decay_chords: None, tev_decay_chords: None, far_field_chords: None, ..LdvmParams::default() };
+        if !mer { p.merge = None; }
+        let n = (1.0 / dt) as usize;
+        let (_, out) = run(p, &m, dt, n);
+        println!("dt {dt} rc {rc} merge {mer}: N at t=0.5 {:.3e}, t=1 {:.3e}", out[n / 2].2.normal_n_m, out[n - 1].2.normal_n_m);
+    }
 }

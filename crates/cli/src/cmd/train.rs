@@ -118,7 +118,10 @@ pub fn run(args: TrainArgs) -> anyhow::Result<()> {
     let ds = Dataset::load(&args.dataset)
         .with_context(|| format!("loading dataset {}", args.dataset.display()))?;
     if !ds.has_outputs() {
-        bail!("{}: dataset has no outputs y to train on", args.dataset.display());
+        bail!(
+            "{}: dataset has no outputs y to train on",
+            args.dataset.display()
+        );
     }
     let all: Vec<Sequence> = ds.train().iter().map(trajectory_sequence).collect();
     if !(0.0..1.0).contains(&args.val_fraction) {
@@ -186,7 +189,8 @@ pub fn run(args: TrainArgs) -> anyhow::Result<()> {
         .context("progress bar template")?
         .progress_chars("=> "),
     );
-    let mut progress = |e: &TrainEvent<'_>| match e {
+    let mut progress = |e: &TrainEvent<'_>| {
+        match e {
         TrainEvent::Step {
             step,
             total_steps,
@@ -225,6 +229,7 @@ pub fn run(args: TrainArgs) -> anyhow::Result<()> {
             ck_path.display()
         )),
         _ => {}
+    }
     };
     println!(
         "{}: {} training / {} validation trajectories; D_x {}, M {}, {} particles, {:?}",

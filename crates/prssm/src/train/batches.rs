@@ -201,7 +201,7 @@ mod tests {
         plan.epoch_order(42, 4, &mut c);
         assert_eq!(a, b);
         assert_ne!(a, c);
-        let mut seen = vec![0; 37];
+        let mut seen = [0; 37];
         let mut batch = Vec::new();
         let mut total = 0;
         for k in 0..plan.batches_per_epoch() {

@@ -254,8 +254,7 @@ pub fn predict_standardized(
     let dx = config.n_state;
     let (mut m0, mut s0) = (vec![0.0; dx], vec![0.0; dx]);
     initial.state(
-        config.n_input,
-        config.n_output,
+        (config.n_input, config.n_output),
         &seq.inputs,
         &seq.outputs,
         0,

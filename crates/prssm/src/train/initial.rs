@@ -67,15 +67,15 @@ pub enum InitialStateError {
 }
 
 impl InitialStateModel {
-    /// Writes `m₀`, `s₀` (`D_x` each) for the sequence with row-major standardized inputs `u`
+    /// Writes `m₀`, `s₀` (`D_x` each) for a model with `(D_u, D_y)` = `dims` and the sequence
+    /// with row-major standardized inputs `u`
     /// (`T × D_u`) and outputs `y` (`T × D_y`) starting at step `start`.
     ///
     /// # Errors
     /// [`InitialStateError`] when `y` is too short for the rule.
     pub fn state(
         &self,
-        d_u: usize,
-        d_y: usize,
+        (d_u, d_y): (usize, usize),
         u: &[f64],
         y: &[f64],
         start: usize,

@@ -253,11 +253,7 @@ impl Recognition {
     /// Returns `false` (leaving `z` untouched) when fewer than `k` steps follow `start`.
     pub fn gather(&self, u: &[f64], y: &[f64], start: usize, z: &mut [f64]) -> bool {
         let (du, dy, k) = (self.d_u, self.d_y, self.config.steps);
-        let n_steps = if du > 0 {
-            u.len() / du
-        } else {
-            y.len() / dy.max(1)
-        };
+        let n_steps = u.len().checked_div(du).unwrap_or(y.len() / dy.max(1));
         if start + k > n_steps || (start + k) * dy > y.len() {
             return false;
         }

@@ -267,28 +267,24 @@ impl TrainOutcome {
     }
 }
 
+/// Computes metrics of flat parameters (see [`TrainHooks::evaluate`]).
+pub type Evaluator<'a> = dyn FnMut(&[f64]) -> Result<Evaluation, String> + 'a;
+
+/// Receives progress events.
+pub type ProgressFn<'a> = dyn FnMut(&TrainEvent<'_>) + 'a;
+
 /// Callbacks and options of a run that are not part of its configuration.
+#[derive(Default)]
 pub struct TrainHooks<'a> {
     /// Computes metrics of the given parameters at evaluated epochs (must be deterministic
     /// for reproducible best-model selection).
-    pub evaluate: Option<&'a mut dyn FnMut(&[f64]) -> Result<Evaluation, String>>,
+    pub evaluate: Option<&'a mut Evaluator<'a>>,
     /// Receives progress events.
-    pub progress: Option<&'a mut dyn FnMut(&TrainEvent<'_>)>,
+    pub progress: Option<&'a mut ProgressFn<'a>>,
     /// Polled before every step; when set, the run checkpoints and returns.
     pub stop: Option<&'a AtomicBool>,
     /// Checkpoint file.
     pub checkpoint: Option<PathBuf>,
-}
-
-impl Default for TrainHooks<'_> {
-    fn default() -> Self {
-        Self {
-            evaluate: None,
-            progress: None,
-            stop: None,
-            checkpoint: None,
-        }
-    }
 }
 
 impl TrainConfig {
@@ -319,12 +315,16 @@ impl TrainConfig {
             );
         }
         if let Some(j) = g.loss_jump
-            && !(j > 0.0)
+            && (j.is_nan() || j <= 0.0)
         {
             return bad("divergence.loss_jump", j.to_string(), "must be positive");
         }
         let a = self.adam;
-        if !(0.0..1.0).contains(&a.beta1) || !(0.0..1.0).contains(&a.beta2) || !(a.eps >= 0.0) {
+        if !(0.0..1.0).contains(&a.beta1)
+            || !(0.0..1.0).contains(&a.beta2)
+            || a.eps.is_nan()
+            || a.eps < 0.0
+        {
             return bad("adam", format!("{a:?}"), "betas in [0, 1), eps >= 0");
         }
         self.schedule.check()?;
