@@ -13,6 +13,7 @@
 //! | [`authority`] | control-authority analysis (Fig. 5 as data, JSON/CSV) | `plotter.m` |
 //! | [`plots`] | PNG/SVG figures (Figs. 2C, 3, 4, 5, training curves) | — |
 //! | [`report`] | one self-contained HTML page | — |
+//! | [`sysid`] | Doerr et al. system-identification protocol (fit, open-loop test, RMSE/NLL) | — |
 //!
 //! Features: `parallel` (default) runs the per-trajectory cross-correlations on rayon.
 #![warn(missing_docs)]
@@ -25,6 +26,7 @@ pub mod metrics;
 pub mod plots;
 pub mod report;
 pub mod stats;
+pub mod sysid;
 pub mod xcorr;
 
 pub use error::{AnalysisError, Result};

@@ -67,7 +67,7 @@ fn fit_csv_matches_scikit_learn_reference() {
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     let t = &v["fit"]["targets"][0];
-    let check = |key: &str, json: &serde_json::Value| {
+    let mut check = |key: &str, json: &serde_json::Value| {
         let want = r.f64(key).unwrap().data;
         let d = max_abs_diff(&floats(json), &want);
         assert!(d < 1e-6, "{key} differs by {d}");

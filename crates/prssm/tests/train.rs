@@ -1,6 +1,8 @@
 //! Trainer tests on analytic objectives: convergence to an independently computed optimum,
 //! bit-identical resume, divergence recovery, best-model selection and schedules.
 
+#![allow(clippy::needless_range_loop)] // index-based Newton solve reads like the math
+
 use std::cell::RefCell;
 use std::sync::atomic::{AtomicBool, Ordering};
 

@@ -13,9 +13,10 @@
 //!   C_rot = π(¾ − x̂0); the ¼t term moves the ¾-chord point continuously to the other side
 //!   when the wing moves TE-first (thin-airfoil theory);
 //! - added mass (Kirchhoff, 2-D flat plate, m_a = πρc²/4, d = (½ − x̂0)c, mid-chord normal
-//!   velocity n_m = n + dω_z): N_am = −m_a(ṅ + dω̇_z), T_am = −m_a ω_z n_m,
-//!   M_am = −m_a[dṅ + (d² + c²/32)ω̇_z]. The steady Munk moment is left out: the measured
-//!   x̂_cp(α) already contains the steady moment.
+//!   velocity n_m = n + dω_z): N_am = −m_a(ṅ + dω̇_z), M_am = −m_a[dṅ + (d² + c²/32)ω̇_z]
+//!   (the physics notes' strip form). The steady Munk moment is left out (the measured
+//!   x̂_cp(α) already contains the steady moment); the chordwise Kirchhoff term
+//!   T_am = −m_a ω_z n_m is off by default, as in the Sane–Dickinson model, and can be switched on.
 //!
 //! C_N* is the Dickinson fit with its offset at 0° removed, C_N*(α) = C_N(α) − C_N(0) cos α,
 //! so that a flat plate gets no normal force at zero incidence (the load stays continuous where
@@ -75,6 +76,8 @@ pub struct QuasiSteadyParams {
     pub rotational: bool,
     /// Include the added-mass loads (true).
     pub added_mass: bool,
+    /// Include the chordwise Kirchhoff added-mass force T_am = −m_a ω_z n_m (false).
+    pub added_mass_chordwise: bool,
 }
 
 impl Default for QuasiSteadyParams {
@@ -84,6 +87,7 @@ impl Default for QuasiSteadyParams {
             skin_friction: 2.0 * 1.328 / 1000f64.sqrt(),
             rotational: true,
             added_mass: true,
+            added_mass_chordwise: false,
         }
     }
 }
@@ -134,7 +138,8 @@ pub fn rotational_normal(
         * ((geom.pitch_axis_frac - 0.5) * speed - 0.25 * chord_m_s)
 }
 
-/// Added-mass loads of a 2-D flat plate (see module docs), per unit span.
+/// Added-mass loads of a 2-D flat plate (see module docs), per unit span, with the chordwise
+/// Kirchhoff term.
 pub fn added_mass(geom: &SectionGeometry, kin: &SectionKinematics) -> SectionLoads {
     let c = geom.chord_m;
     let m_a = 0.25 * PI * geom.density_kg_m3 * c * c;
@@ -147,6 +152,18 @@ pub fn added_mass(geom: &SectionGeometry, kin: &SectionKinematics) -> SectionLoa
             * (d * kin.normal_velocity_rate_m_s2
                 + (d * d + c * c / 32.0) * kin.rotation_acc_rad_s2),
     }
+}
+
+/// The added-mass loads that `params` switch on (zero when `added_mass` is off).
+pub fn added_mass_loads(geom: &SectionGeometry, params: &QuasiSteadyParams, kin: &SectionKinematics) -> SectionLoads {
+    if !params.added_mass {
+        return SectionLoads::default();
+    }
+    let mut am = added_mass(geom, kin);
+    if !params.added_mass_chordwise {
+        am.chordwise_n_m = 0.0;
+    }
+    am
 }
 
 /// Circulatory (translational + rotational) quasi-steady loads per unit span for a section

@@ -1,0 +1,478 @@
+//! The system-identification protocol of Doerr et al. (2018) on one recorded input/output
+//! table: fit a PR-SSM on the first part, simulate the rest open loop, score it.
+//!
+//! Protocol ([`SysidSpec::reference`], `docs/sysid.md`):
+//!
+//! 1. Split the `T` samples at `n_train = ⌊split · T⌋`: train `0..n_train`, test `n_train..T`.
+//! 2. Fit the `sysid` preset of [`FitSpec`] (z-scoring with training statistics, ddof 0;
+//!    windows of 50 at stride 1, batch 10, `D_x = 4`, `M = 20`, SE-ARD, 50 particles,
+//!    Adam lr 0.1, 3000 iterations, recognition of `x₀` from the first 16 steps) once per seed.
+//! 3. Predict the whole test part open loop, the initial state recognized from its first 16
+//!    steps of `(u, y)`, and score every test step:
+//!
+//! ```text
+//! RMSE_raw = sqrt( 1/(T_test·D_y) Σ_t Σ_j (y_tj − m_tj)² )                     (raw units)
+//! NLL      = 1/(T_test·D_y) Σ_t Σ_j [ ½ ln(2π v_tj) + (y_tj − m_tj)² / (2 v_tj) ]
+//! ```
+//!
+//! with the predictive mean `m` and variance `v` (particle variance + `σ_y²`); the NLL is in
+//! standardized units (`y`, `m`, `v` divided by the training std, so it is comparable across
+//! data sets), per sample and output.
+
+use std::path::Path;
+use std::time::Instant;
+
+use flapssm_data::table::{Column, Table, TableError};
+use flapssm_prssm::Sequence;
+use flapssm_prssm::predict::Prediction;
+use flapssm_prssm::train::batches::derive_seed;
+use flapssm_prssm::train::fit::{FitError, FitSpec, Preset, fit, predict_raw};
+use flapssm_prssm::train::{Budget, TrainHooks};
+use serde::{Deserialize, Serialize};
+
+/// Seed stream of test-time particle draws.
+const PREDICT_STREAM: u64 = 40;
+
+/// Fewest training samples the protocol accepts.
+pub const MIN_TRAIN_SAMPLES: usize = 100;
+
+/// Why the protocol could not run.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum SysidError {
+    /// The table could not be read or a column does not exist.
+    #[error(transparent)]
+    Table(#[from] TableError),
+    /// A setting is out of range.
+    #[error("{field} = {value}: {why}")]
+    Setting {
+        /// Option name.
+        field: &'static str,
+        /// Value, formatted.
+        value: String,
+        /// Requirement.
+        why: String,
+    },
+    /// The split leaves too few samples on one side.
+    #[error(
+        "split {split} of {n_samples} samples leaves {n_train} training and {n_test} test samples; need at least {min_train} training and {min_test} test samples"
+    )]
+    Split {
+        /// The split fraction.
+        split: f64,
+        /// Samples in the table.
+        n_samples: usize,
+        /// Training samples.
+        n_train: usize,
+        /// Test samples.
+        n_test: usize,
+        /// Minimum of training samples.
+        min_train: usize,
+        /// Minimum of test samples.
+        min_test: usize,
+    },
+    /// Fitting or predicting failed.
+    #[error("seed {seed}: {source}")]
+    Fit {
+        /// Seed of the failed run.
+        seed: u64,
+        /// Cause.
+        source: FitError,
+    },
+}
+
+/// Input/output columns of a recorded table, row-major.
+#[derive(Debug, Clone, PartialEq)]
+pub struct IoRecord {
+    /// Input column names.
+    pub input_names: Vec<String>,
+    /// Output column names.
+    pub output_names: Vec<String>,
+    /// Inputs `u`, row-major `T × D_u`.
+    pub inputs: Vec<f64>,
+    /// Outputs `y`, row-major `T × D_y`.
+    pub outputs: Vec<f64>,
+}
+
+impl IoRecord {
+    /// Samples `T`.
+    pub fn n_samples(&self) -> usize {
+        self.outputs.len() / self.output_names.len().max(1)
+    }
+
+    /// Reads `path` ([`Table::read`] by extension; for `.mat`, only the named variables when
+    /// every column is given by name) and selects the input and output columns.
+    ///
+    /// # Errors
+    /// [`SysidError::Table`] for unreadable files and unknown columns (listing the available
+    /// ones), [`SysidError::Setting`] when no input or output is selected.
+    pub fn read(path: &Path, inputs: &[Column], outputs: &[Column]) -> Result<Self, SysidError> {
+        if inputs.is_empty() || outputs.is_empty() {
+            return Err(SysidError::Setting {
+                field: if inputs.is_empty() { "input" } else { "output" },
+                value: "none".into(),
+                why: "select at least one column".into(),
+            });
+        }
+        let is_mat = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .is_some_and(|e| e.eq_ignore_ascii_case("mat"));
+        let names: Option<Vec<&str>> = inputs
+            .iter()
+            .chain(outputs)
+            .map(|c| match c {
+                Column::Name(n) => Some(n.as_str()),
+                Column::Index(_) => None,
+            })
+            .collect();
+        let table = match (is_mat, names) {
+            (true, Some(n)) => {
+                let mut uniq: Vec<&str> = Vec::new();
+                for v in n {
+                    if !uniq.contains(&v) {
+                        uniq.push(v);
+                    }
+                }
+                Table::read_mat(path, &uniq)?
+            }
+            _ => Table::read(path)?,
+        };
+        Ok(Self::from_table(&table, inputs, outputs)?)
+    }
+
+    /// Selects the input and output columns of `table`.
+    ///
+    /// # Errors
+    /// [`TableError::UnknownColumn`].
+    pub fn from_table(
+        table: &Table,
+        inputs: &[Column],
+        outputs: &[Column],
+    ) -> Result<Self, TableError> {
+        let u = table.select(inputs)?;
+        let y = table.select(outputs)?;
+        let interleave = |t: &Table| -> Vec<f64> {
+            (0..t.n_rows())
+                .flat_map(|i| t.columns.iter().map(move |c| c[i]))
+                .collect()
+        };
+        Ok(Self {
+            inputs: interleave(&u),
+            outputs: interleave(&y),
+            input_names: u.names,
+            output_names: y.names,
+        })
+    }
+
+    /// The samples `range` as a raw PR-SSM sequence.
+    fn sequence(&self, range: std::ops::Range<usize>) -> Sequence {
+        let (du, dy) = (self.input_names.len(), self.output_names.len());
+        Sequence {
+            inputs: self.inputs[range.start * du..range.end * du].to_vec(),
+            outputs: self.outputs[range.start * dy..range.end * dy].to_vec(),
+        }
+    }
+}
+
+/// Settings of the protocol.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SysidSpec {
+    /// Fraction of the samples (the first ones) used for training, in (0, 1).
+    pub split: f64,
+    /// Seeds `0..seeds` (one fit each).
+    pub seeds: u64,
+    /// Optimizer steps per fit.
+    pub iterations: u64,
+    /// Particles of the test-time prediction.
+    pub predict_particles: usize,
+}
+
+impl SysidSpec {
+    /// The reference protocol: split 0.5, 3 seeds, 3000 iterations, 50 prediction particles.
+    pub fn reference() -> Self {
+        Self {
+            split: 0.5,
+            seeds: 3,
+            iterations: 3000,
+            predict_particles: 50,
+        }
+    }
+
+    /// The fit of one seed (the `sysid` preset with this spec's iterations).
+    pub fn fit_spec(&self, n_input: usize, n_output: usize, seed: u64) -> FitSpec {
+        let mut spec = FitSpec::preset(Preset::Sysid, n_input, n_output);
+        spec.train.budget = Budget::Iterations(self.iterations);
+        spec.train.seed = seed;
+        spec
+    }
+
+    fn check(&self) -> Result<(), SysidError> {
+        let bad = |field, value: String, why: &str| {
+            Err(SysidError::Setting {
+                field,
+                value,
+                why: why.into(),
+            })
+        };
+        if !(self.split > 0.0 && self.split < 1.0) {
+            return bad("split", self.split.to_string(), "must be in (0, 1)");
+        }
+        if self.seeds == 0 {
+            return bad("seeds", "0".into(), "must be ≥ 1");
+        }
+        if self.iterations == 0 {
+            return bad("iterations", "0".into(), "must be ≥ 1");
+        }
+        if self.predict_particles == 0 {
+            return bad("predict_particles", "0".into(), "must be ≥ 1");
+        }
+        Ok(())
+    }
+}
+
+/// Test scores of one prediction.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Scores {
+    /// RMSE over every test step and output, raw units.
+    pub rmse: f64,
+    /// Gaussian NLL per sample and output, standardized units (module docs).
+    pub nll: f64,
+}
+
+/// Scores `pred` (raw units) against raw outputs `y` (`T × D_y`) with training stds `std`.
+pub fn score(y: &[f64], mean: &[f64], var: &[f64], std: &[f64]) -> Scores {
+    let dy = std.len().max(1);
+    let (mut s2, mut nll) = (0.0, 0.0);
+    for (i, ((y, m), v)) in y.iter().zip(mean).zip(var).enumerate() {
+        let e = y - m;
+        s2 += e * e;
+        let s = std[i % dy];
+        let vz = v / (s * s);
+        let ez = e / s;
+        nll += 0.5 * (2.0 * std::f64::consts::PI * vz).ln() + ez * ez / (2.0 * vz);
+    }
+    let n = y.len().max(1) as f64;
+    Scores {
+        rmse: (s2 / n).sqrt(),
+        nll: nll / n,
+    }
+}
+
+/// One seed's result.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SeedRun {
+    /// Seed.
+    pub seed: u64,
+    /// Test scores.
+    pub test: Scores,
+    /// Per-output test RMSE, raw units (`D_y`).
+    pub rmse_per_output: Vec<f64>,
+    /// Wall time of fit + prediction, seconds.
+    pub wall_s: f64,
+    /// Steps rejected by the divergence guard.
+    pub rejected_steps: u64,
+}
+
+/// Mean and standard deviation (ddof 0) over seeds.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct MeanStd {
+    /// Mean.
+    pub mean: f64,
+    /// Standard deviation (ddof 0).
+    pub std: f64,
+}
+
+impl MeanStd {
+    /// Of `values` (NaN when empty).
+    pub fn of(values: impl IntoIterator<Item = f64>) -> Self {
+        let v: Vec<f64> = values.into_iter().collect();
+        let n = v.len() as f64;
+        let mean = v.iter().sum::<f64>() / n;
+        let var = v.iter().map(|x| (x - mean) * (x - mean)).sum::<f64>() / n;
+        Self {
+            mean,
+            std: var.sqrt(),
+        }
+    }
+}
+
+/// The protocol's result.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SysidReport {
+    /// Settings used.
+    pub spec: SysidSpec,
+    /// Input column names.
+    pub inputs: Vec<String>,
+    /// Output column names.
+    pub outputs: Vec<String>,
+    /// Training samples.
+    pub n_train: usize,
+    /// Test samples.
+    pub n_test: usize,
+    /// Test RMSE (raw units) of predicting the training mean.
+    pub mean_predictor_rmse: f64,
+    /// Per seed.
+    pub runs: Vec<SeedRun>,
+    /// Test RMSE over seeds.
+    pub rmse: MeanStd,
+    /// Test NLL over seeds.
+    pub nll: MeanStd,
+    /// Wall time per run over seeds.
+    pub wall_s: MeanStd,
+}
+
+/// The test half and the first seed's prediction, for the figure.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TestTrace {
+    /// Measured test outputs, raw, row-major `T_test × D_y`.
+    pub outputs: Vec<f64>,
+    /// Prediction of the first seed (raw output moments).
+    pub prediction: Prediction,
+}
+
+/// Training/test sample counts for `n` samples, checked.
+///
+/// # Errors
+/// [`SysidError::Split`] when fewer than [`MIN_TRAIN_SAMPLES`] training samples or fewer test
+/// samples than the recognition window remain.
+pub fn split_counts(split: f64, n: usize, min_test: usize) -> Result<(usize, usize), SysidError> {
+    let n_train = ((split * n as f64).floor() as usize).min(n);
+    let n_test = n - n_train;
+    if n_train < MIN_TRAIN_SAMPLES || n_test < min_test {
+        return Err(SysidError::Split {
+            split,
+            n_samples: n,
+            n_train,
+            n_test,
+            min_train: MIN_TRAIN_SAMPLES,
+            min_test,
+        });
+    }
+    Ok((n_train, n_test))
+}
+
+/// Runs the protocol on `record`, one fit per seed (sequentially; each fit is parallel
+/// inside). `progress` receives each finished run.
+///
+/// # Errors
+/// [`SysidError`] for bad settings, a bad split or a failed fit.
+pub fn run(
+    record: &IoRecord,
+    spec: &SysidSpec,
+    mut progress: impl FnMut(&SeedRun),
+) -> Result<(SysidReport, TestTrace), SysidError> {
+    spec.check()?;
+    let (du, dy) = (record.input_names.len(), record.output_names.len());
+    let n = record.n_samples();
+    let probe = spec.fit_spec(du, dy, 0);
+    let window = match probe.train.windows {
+        flapssm_prssm::train::WindowSpec::Windows { len, .. } => len,
+        _ => 1,
+    };
+    let recog = match probe.initial_state {
+        flapssm_prssm::train::InitialStateSpec::Recognition(rc) => rc.steps,
+        _ => 1,
+    };
+    let (n_train, n_test) = split_counts(spec.split, n, recog)?;
+    if n_train < window {
+        return Err(SysidError::Split {
+            split: spec.split,
+            n_samples: n,
+            n_train,
+            n_test,
+            min_train: window,
+            min_test: recog,
+        });
+    }
+    let train = record.sequence(0..n_train);
+    let test = record.sequence(n_train..n);
+    let norm = flapssm_prssm::train::fit::normalization(std::slice::from_ref(&train), du, dy);
+    let mean_pred: Vec<f64> = (0..test.outputs.len())
+        .map(|i| norm.output_mean[i % dy])
+        .collect();
+    let mean_predictor_rmse = score(
+        &test.outputs,
+        &mean_pred,
+        &vec![1.0; mean_pred.len()],
+        &norm.output_std,
+    )
+    .rmse;
+    let mut runs = Vec::new();
+    let mut first: Option<Prediction> = None;
+    for seed in 0..spec.seeds {
+        let t0 = Instant::now();
+        let fs = spec.fit_spec(du, dy, seed);
+        let err = |source| SysidError::Fit { seed, source };
+        let out = fit(
+            &fs,
+            std::slice::from_ref(&train),
+            &[],
+            TrainHooks::default(),
+            None,
+        )
+        .map_err(err)?;
+        let pred = predict_raw(
+            &out.best,
+            &test,
+            spec.predict_particles,
+            derive_seed(seed, PREDICT_STREAM, 0),
+        )
+        .map_err(err)?;
+        let wall_s = t0.elapsed().as_secs_f64();
+        let test_scores = score(
+            &test.outputs,
+            &pred.output_mean,
+            &pred.output_var,
+            &norm.output_std,
+        );
+        let rmse_per_output = (0..dy)
+            .map(|j| {
+                let (mut s2, mut k) = (0.0, 0.0);
+                for (y, m) in test
+                    .outputs
+                    .iter()
+                    .zip(&pred.output_mean)
+                    .skip(j)
+                    .step_by(dy)
+                {
+                    s2 += (y - m) * (y - m);
+                    k += 1.0;
+                }
+                (s2 / f64::max(k, 1.0)).sqrt()
+            })
+            .collect();
+        let r = SeedRun {
+            seed,
+            test: test_scores,
+            rmse_per_output,
+            wall_s,
+            rejected_steps: out.outcome.state.rejected,
+        };
+        progress(&r);
+        runs.push(r);
+        first.get_or_insert(pred);
+    }
+    let report = SysidReport {
+        spec: spec.clone(),
+        inputs: record.input_names.clone(),
+        outputs: record.output_names.clone(),
+        n_train,
+        n_test,
+        mean_predictor_rmse,
+        rmse: MeanStd::of(runs.iter().map(|r| r.test.rmse)),
+        nll: MeanStd::of(runs.iter().map(|r| r.test.nll)),
+        wall_s: MeanStd::of(runs.iter().map(|r| r.wall_s)),
+        runs,
+    };
+    let trace = TestTrace {
+        outputs: test.outputs,
+        prediction: first.unwrap_or_else(|| Prediction {
+            output_mean: Vec::new(),
+            output_var: Vec::new(),
+            latent_mean: Vec::new(),
+            latent_var: Vec::new(),
+        }),
+    };
+    Ok((report, trace))
+}
