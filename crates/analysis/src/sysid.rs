@@ -165,6 +165,18 @@ impl IoRecord {
         })
     }
 
+    /// The first `n` samples (all when `n ≥ T`), e.g. the training part for a validation split.
+    pub fn head(&self, n: usize) -> IoRecord {
+        let n = n.min(self.n_samples());
+        let (du, dy) = (self.input_names.len(), self.output_names.len());
+        IoRecord {
+            input_names: self.input_names.clone(),
+            output_names: self.output_names.clone(),
+            inputs: self.inputs[..n * du].to_vec(),
+            outputs: self.outputs[..n * dy].to_vec(),
+        }
+    }
+
     /// The samples `range` as a raw PR-SSM sequence.
     fn sequence(&self, range: std::ops::Range<usize>) -> Sequence {
         let (du, dy) = (self.input_names.len(), self.output_names.len());
@@ -180,34 +192,33 @@ impl IoRecord {
 pub struct SysidSpec {
     /// Fraction of the samples (the first ones) used for training, in (0, 1).
     pub split: f64,
-    /// Seeds `0..seeds` (one fit each).
+    /// Seeds `0..seeds` (one fit each; the seed replaces `fit.train.seed`).
     pub seeds: u64,
-    /// Optimizer steps per fit.
-    pub iterations: u64,
     /// Particles of the test-time prediction.
     pub predict_particles: usize,
+    /// The fit (model sizes must match the record's `D_u`, `D_y`).
+    pub fit: FitSpec,
 }
 
 impl SysidSpec {
-    /// The reference protocol: split 0.5, 3 seeds, 3000 iterations, 50 prediction particles.
-    pub fn reference() -> Self {
+    /// The reference protocol for `n_input` inputs and `n_output` outputs: split 0.5, 3 seeds,
+    /// the `sysid` preset (3000 iterations), 50 prediction particles.
+    pub fn reference(n_input: usize, n_output: usize) -> Self {
         Self {
             split: 0.5,
             seeds: 3,
-            iterations: 3000,
             predict_particles: 50,
+            fit: FitSpec::preset(Preset::Sysid, n_input, n_output),
         }
     }
 
-    /// The fit of one seed (the `sysid` preset with this spec's iterations).
-    pub fn fit_spec(&self, n_input: usize, n_output: usize, seed: u64) -> FitSpec {
-        let mut spec = FitSpec::preset(Preset::Sysid, n_input, n_output);
-        spec.train.budget = Budget::Iterations(self.iterations);
-        spec.train.seed = seed;
-        spec
+    /// Sets the optimizer steps per fit.
+    pub fn with_iterations(mut self, iterations: u64) -> Self {
+        self.fit.train.budget = Budget::Iterations(iterations);
+        self
     }
 
-    fn check(&self) -> Result<(), SysidError> {
+    fn check(&self, n_input: usize, n_output: usize) -> Result<(), SysidError> {
         let bad = |field, value: String, why: &str| {
             Err(SysidError::Setting {
                 field,
@@ -221,11 +232,22 @@ impl SysidSpec {
         if self.seeds == 0 {
             return bad("seeds", "0".into(), "must be ≥ 1");
         }
-        if self.iterations == 0 {
+        if matches!(
+            self.fit.train.budget,
+            Budget::Iterations(0) | Budget::Epochs(0)
+        ) {
             return bad("iterations", "0".into(), "must be ≥ 1");
         }
         if self.predict_particles == 0 {
             return bad("predict_particles", "0".into(), "must be ≥ 1");
+        }
+        let m = &self.fit.model;
+        if (m.n_input, m.n_output) != (n_input, n_output) {
+            return bad(
+                "fit.model (n_input, n_output)",
+                format!("({}, {})", m.n_input, m.n_output),
+                &format!("the record has {n_input} inputs and {n_output} outputs"),
+            );
         }
         Ok(())
     }
@@ -272,6 +294,8 @@ pub struct SeedRun {
     pub wall_s: f64,
     /// Steps rejected by the divergence guard.
     pub rejected_steps: u64,
+    /// Test scores of the last (not the selected best) parameters, when asked for.
+    pub last_test: Option<Scores>,
 }
 
 /// Mean and standard deviation (ddof 0) over seeds.
@@ -353,19 +377,22 @@ pub fn split_counts(split: f64, n: usize, min_test: usize) -> Result<(usize, usi
 }
 
 /// Runs the protocol on `record`, one fit per seed (sequentially; each fit is parallel
-/// inside). `progress` receives each finished run.
+/// inside). The selected (`best`) model of each fit is scored; with `diagnose_last` the last
+/// parameters are scored too ([`SeedRun::last_test`], diagnostics only). `progress` receives
+/// each finished run.
 ///
 /// # Errors
 /// [`SysidError`] for bad settings, a bad split or a failed fit.
 pub fn run(
     record: &IoRecord,
     spec: &SysidSpec,
+    diagnose_last: bool,
     mut progress: impl FnMut(&SeedRun),
 ) -> Result<(SysidReport, TestTrace), SysidError> {
-    spec.check()?;
     let (du, dy) = (record.input_names.len(), record.output_names.len());
+    spec.check(du, dy)?;
     let n = record.n_samples();
-    let probe = spec.fit_spec(du, dy, 0);
+    let probe = &spec.fit;
     let window = match probe.train.windows {
         flapssm_prssm::train::WindowSpec::Windows { len, .. } => len,
         _ => 1,
@@ -402,7 +429,8 @@ pub fn run(
     let mut first: Option<Prediction> = None;
     for seed in 0..spec.seeds {
         let t0 = Instant::now();
-        let fs = spec.fit_spec(du, dy, seed);
+        let mut fs = spec.fit.clone();
+        fs.train.seed = seed;
         let err = |source| SysidError::Fit { seed, source };
         let out = fit(
             &fs,
@@ -420,6 +448,19 @@ pub fn run(
         )
         .map_err(err)?;
         let wall_s = t0.elapsed().as_secs_f64();
+        let last_scores = match diagnose_last {
+            true => {
+                let p = predict_raw(
+                    &out.last,
+                    &test,
+                    spec.predict_particles,
+                    derive_seed(seed, PREDICT_STREAM, 0),
+                )
+                .map_err(err)?;
+                Some(score(&test.outputs, &p.output_mean, &p.output_var, &norm.output_std))
+            }
+            false => None,
+        };
         let test_scores = score(
             &test.outputs,
             &pred.output_mean,
@@ -448,6 +489,7 @@ pub fn run(
             rmse_per_output,
             wall_s,
             rejected_steps: out.outcome.state.rejected,
+            last_test: last_scores,
         };
         progress(&r);
         runs.push(r);

@@ -34,6 +34,8 @@ enum Command {
         #[command(subcommand)]
         command: cmd::qs::QsCommand,
     },
+    /// System identification on recorded data (Doerr et al. protocol): fit, open-loop test.
+    Sysid(cmd::sysid::SysidArgs),
 }
 
 fn main() {
@@ -47,6 +49,7 @@ fn main() {
         Command::Bench(args) => cmd::bench::run(args),
         Command::Trajectories(args) => cmd::trajectories::run(args),
         Command::Qs { command } => cmd::qs::run(command),
+        Command::Sysid(args) => cmd::sysid::run(args),
     };
     if let Err(err) = result {
         eprintln!("error: {err:#}");

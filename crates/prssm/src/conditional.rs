@@ -1,20 +1,27 @@
 //! The sparse-GP conditional `f(X) | q(u)` of all latent dims at a batch of `N` points, and
 //! its reverse mode. [`Posterior`] caches what depends only on the parameters (`L = chol(K_mm
-//! + jitter·I)`, scaled `Z`); a [`ConditionalWorkspace`] holds the per-batch buffers.
+//! + jitter·I)`, the projection `G`, scaled `Z`); a [`ConditionalWorkspace`] holds the
+//! per-batch buffers.
 //!
-//! With `K = K_mn` (`M × N`), `A = L⁻¹K`, `W = L⁻ᵀA` (unwhitened) or `W = A` (whitened):
+//! With `K = K_mn` (`M × N`) and `W = G K`, where `G = (K_mm + jitter·I)⁻¹ = L⁻ᵀL⁻¹`
+//! (unwhitened) or `G = L⁻¹` (whitened):
 //!
 //! ```text
 //! μ_d(x_n)  = Σ_m m_{md} W_{mn}
-//! σ²_d(x_n) = σ_f² − Σ_m A_{mn}² + Σ_m S_{md} W_{mn}²      (diagonal S)
-//!           = σ_f² − Σ_m A_{mn}² + ‖L_dᵀ W_{:n}‖²            (full S = L_d L_dᵀ)
+//! σ²_d(x_n) = σ_f² − Σ_m H_{mn} W_{mn} + Σ_m S_{md} W_{mn}²      (diagonal S)
+//!           = σ_f² − Σ_m H_{mn} W_{mn} + ‖L_dᵀ W_{:n}‖²            (full S = L_d L_dᵀ)
 //! ```
-//! Cost per batch: `O(M D N)` kernel, two (one whitened) triangular solves `M²N`.
+//! with `H = K` (unwhitened: `Σ K⊙W = kᵀ(K_mm)⁻¹k`) or `H = W` (whitened: `Σ W² = ‖L⁻¹k‖²`).
+//! Cost per batch: `O(M D N)` kernel and one `M × M × N` product; the reverse mode needs two
+//! more (`K̄ = Gᵀ W̄`, `Ḡ += W̄ Kᵀ`). `Ḡ` is mapped to `K̄_mm` once per evaluation
+//! ([`Posterior::kmm_grad`]).
 
 use faer::Accum;
 
 use crate::kernel::{self, KernelKind};
-use crate::linalg::{cholesky_in_place, gemm, solve_lower, solve_lower_transpose, view, view_mut};
+use crate::linalg::{
+    cholesky_backward, cholesky_in_place, gemm, lower_inverse, view, view_mut,
+};
 use crate::objective::ObjectiveError;
 use crate::params::{CovarianceStructure, ModelConfig, Parametrization, Params};
 
@@ -36,6 +43,8 @@ pub struct Posterior {
     pub(crate) kmm_kd: Vec<f64>,
     /// Lower Cholesky factor of `K_mm + jitter·I`.
     pub(crate) l: Vec<f64>,
+    /// `G`: `(K_mm + jitter·I)⁻¹` (unwhitened) or `L⁻¹` (whitened), `M × M`.
+    pub(crate) g: Vec<f64>,
     /// `q(u)` means: row-major `M × D_x` = column-major `D_x × M`.
     pub(crate) q_mean: Vec<f64>,
     /// Diagonal: row-major `M × D_x`; full: `D_x` column-major `M × M` factors.
@@ -45,7 +54,7 @@ pub struct Posterior {
 }
 
 impl Posterior {
-    /// Builds the cache; factorizes `K_mm + jitter·I` once.
+    /// Builds the cache; factorizes `K_mm + jitter·I` once and forms `G`.
     ///
     /// # Errors
     /// [`ObjectiveError::NotPositiveDefinite`] when the factorization fails.
@@ -76,6 +85,27 @@ impl Posterior {
             what: "K_mm",
             index,
         })?;
+        let whitened = config.parametrization == Parametrization::Whitened;
+        let linv = lower_inverse(&l, m);
+        let g = if whitened {
+            linv
+        } else {
+            let mut p = vec![0.0; m * m];
+            gemm(
+                view_mut(&mut p, m, m),
+                Accum::Replace,
+                view(&linv, m, m).transpose(),
+                view(&linv, m, m),
+                1.0,
+            );
+            // Exactly symmetric.
+            for j in 0..m {
+                for i in j + 1..m {
+                    p[i * m + j] = p[j * m + i];
+                }
+            }
+            p
+        };
         Ok(Self {
             kind: config.kernel,
             variance: params.kernel_variance,
@@ -88,16 +118,68 @@ impl Posterior {
             kmm,
             kmm_kd,
             l,
+            g,
             q_mean: params.q_mean.clone(),
             q_cov: params.q_cov.clone(),
             cov: config.covariance,
-            whitened: config.parametrization == Parametrization::Whitened,
+            whitened,
         })
     }
 
     /// The lower Cholesky factor of `K_mm + jitter·I` (column-major `M × M`).
     pub fn kmm_factor(&self) -> &[f64] {
         &self.l
+    }
+
+    /// Maps the adjoint `Ḡ` (`M × M`) of the projection `G` to `∂loss/∂K_mm` (`M × M`,
+    /// column-major; every entry treated as independent):
+    /// unwhitened `G = K⁻¹`: `K̄ = −G Ḡ G`; whitened `G = L⁻¹`: `L̄ = −tril(Gᵀ tril(Ḡ) Gᵀ)`,
+    /// then the Cholesky adjoint. `gbar` is overwritten. Cost `O(M³)`.
+    pub(crate) fn kmm_grad(&self, gbar: &mut [f64]) -> Vec<f64> {
+        let m = self.m;
+        let mut t = vec![0.0; m * m];
+        let mut out = vec![0.0; m * m];
+        if self.whitened {
+            for j in 0..m {
+                gbar[j * m..j * m + j].fill(0.0);
+            }
+            let gt = view(&self.g, m, m).transpose();
+            gemm(view_mut(&mut t, m, m), Accum::Replace, gt, view(gbar, m, m), 1.0);
+            gemm(view_mut(&mut out, m, m), Accum::Replace, view(&t, m, m), gt, -1.0);
+            cholesky_backward(&self.l, &mut out, m)
+        } else {
+            let g = view(&self.g, m, m);
+            gemm(view_mut(&mut t, m, m), Accum::Replace, g, view(gbar, m, m), 1.0);
+            gemm(view_mut(&mut out, m, m), Accum::Replace, view(&t, m, m), g, -1.0);
+            out
+        }
+    }
+}
+
+/// Per-step values kept for the reverse mode: the scaled inputs `X̃` (`D × N`), `K`, `σ_f² g'`
+/// and `W` (`M × N` each), stored in one slice of [`tape_len`] values.
+struct Tape<'a> {
+    xs: &'a mut [f64],
+    k: &'a mut [f64],
+    kd: &'a mut [f64],
+    w: &'a mut [f64],
+}
+
+/// Values per step stored for the reverse mode of a batch of `capacity` points.
+pub fn tape_len(post: &Posterior, capacity: usize) -> usize {
+    (post.d + 3 * post.m) * capacity
+}
+
+fn split_tape<'a>(post: &Posterior, cap: usize, n: usize, tape: &'a mut [f64]) -> Tape<'a> {
+    let (d, m) = (post.d, post.m);
+    let (xs, rest) = tape.split_at_mut(d * cap);
+    let (k, rest) = rest.split_at_mut(m * cap);
+    let (kd, w) = rest.split_at_mut(m * cap);
+    Tape {
+        xs: &mut xs[..d * n],
+        k: &mut k[..m * n],
+        kd: &mut kd[..m * n],
+        w: &mut w[..m * n],
     }
 }
 
@@ -107,14 +189,10 @@ pub struct ConditionalWorkspace {
     cap: usize,
     /// GP inputs `[x; u]`, column-major `D × N` (filled by the caller).
     pub input: Vec<f64>,
-    xs: Vec<f64>,
-    k: Vec<f64>,
-    kd: Vec<f64>,
-    a: Vec<f64>,
-    b: Vec<f64>,
+    tape: Vec<f64>,
     w2: Vec<f64>,
     wbar: Vec<f64>,
-    tmp: Vec<f64>,
+    kbar: Vec<f64>,
     base_bar: Vec<f64>,
     cx: Vec<f64>,
     zc: Vec<f64>,
@@ -138,8 +216,8 @@ pub struct ConditionalGrads {
     pub(crate) q_mean: Vec<f64>,
     /// `∂/∂S` or `∂/∂L_d` (layout of [`Params::q_cov`]).
     pub(crate) q_cov: Vec<f64>,
-    /// `∂/∂L` of `chol(K_mm)` (full `M × M`; only the lower triangle is used).
-    pub(crate) lbar: Vec<f64>,
+    /// `∂/∂G` (`M × M`, see [`Posterior::kmm_grad`]).
+    pub(crate) gbar: Vec<f64>,
 }
 
 impl ConditionalGrads {
@@ -151,7 +229,7 @@ impl ConditionalGrads {
             variance: 0.0,
             q_mean: vec![0.0; post.m * post.dx],
             q_cov: vec![0.0; post.q_cov.len()],
-            lbar: vec![0.0; post.m * post.m],
+            gbar: vec![0.0; post.m * post.m],
         }
     }
 
@@ -165,7 +243,7 @@ impl ConditionalGrads {
         self.variance += o.variance;
         acc(&mut self.q_mean, &o.q_mean);
         acc(&mut self.q_cov, &o.q_cov);
-        acc(&mut self.lbar, &o.lbar);
+        acc(&mut self.gbar, &o.gbar);
     }
 }
 
@@ -176,18 +254,10 @@ impl ConditionalWorkspace {
         Self {
             cap: n,
             input: vec![0.0; d * n],
-            xs: vec![0.0; d * n],
-            k: vec![0.0; m * n],
-            kd: vec![0.0; m * n],
-            a: vec![0.0; m * n],
-            b: if post.whitened {
-                Vec::new()
-            } else {
-                vec![0.0; m * n]
-            },
+            tape: vec![0.0; tape_len(post, n)],
             w2: vec![0.0; m * n],
             wbar: vec![0.0; m * n],
-            tmp: vec![0.0; m * n],
+            kbar: vec![0.0; m * n],
             base_bar: vec![0.0; n],
             cx: vec![0.0; m * d],
             zc: vec![0.0; d * n],
@@ -205,26 +275,35 @@ impl ConditionalWorkspace {
     /// Computes `μ` and `σ²` at the first `n` columns of [`Self::input`] into
     /// [`Self::mean`] / [`Self::var`]. Allocates nothing.
     pub fn forward(&mut self, post: &Posterior, n: usize) {
+        let mut tape = std::mem::take(&mut self.tape);
+        self.forward_tape(post, n, &mut tape);
+        self.tape = tape;
+    }
+
+    /// [`Self::forward`] storing the step's intermediates in `tape` ([`tape_len`] values).
+    pub(crate) fn forward_tape(&mut self, post: &Posterior, n: usize, tape: &mut [f64]) {
         let (m, d, dx) = (post.m, post.d, post.dx);
         debug_assert!(n <= self.cap);
-        kernel::scale_points(&self.input[..d * n], &post.inv_len, &mut self.xs[..d * n]);
+        let t = split_tape(post, self.cap, n, tape);
+        kernel::scale_points(&self.input[..d * n], &post.inv_len, t.xs);
         kernel::cross_cov(
             post.kind,
             post.variance,
             post.tau_jitter,
             &post.zt,
-            &self.xs[..d * n],
+            t.xs,
             d,
-            &mut self.k[..m * n],
-            &mut self.kd[..m * n],
+            t.k,
+            t.kd,
         );
-        self.a[..m * n].copy_from_slice(&self.k[..m * n]);
-        solve_lower(&post.l, m, &mut self.a, n);
-        if !post.whitened {
-            self.b[..m * n].copy_from_slice(&self.a[..m * n]);
-            solve_lower_transpose(&post.l, m, &mut self.b, n);
-        }
-        let w = if post.whitened { &self.a } else { &self.b };
+        gemm(
+            view_mut(t.w, m, n),
+            Accum::Replace,
+            view(&post.g, m, m),
+            view(t.k, m, n),
+            1.0,
+        );
+        let w = &*t.w;
         gemm(
             view_mut(&mut self.mean, dx, n),
             Accum::Replace,
@@ -232,40 +311,45 @@ impl ConditionalWorkspace {
             view(w, m, n),
             1.0,
         );
-        for ((w2, wv), _) in self.w2[..m * n].iter_mut().zip(&w[..m * n]).zip(0..) {
-            *w2 = wv * wv;
-        }
         match post.cov {
-            CovarianceStructure::Diagonal => gemm(
-                view_mut(&mut self.var, dx, n),
-                Accum::Replace,
-                view(&post.q_cov, dx, m),
-                view(&self.w2, m, n),
-                1.0,
-            ),
+            CovarianceStructure::Diagonal => {
+                for (w2, &wv) in self.w2[..m * n].iter_mut().zip(w) {
+                    *w2 = wv * wv;
+                }
+                gemm(
+                    view_mut(&mut self.var, dx, n),
+                    Accum::Replace,
+                    view(&post.q_cov, dx, m),
+                    view(&self.w2, m, n),
+                    1.0,
+                )
+            }
             CovarianceStructure::Full => {
                 for dd in 0..dx {
                     let ld = &post.q_cov[dd * m * m..(dd + 1) * m * m];
                     gemm(
-                        view_mut(&mut self.tmp, m, n),
+                        view_mut(&mut self.w2, m, n),
                         Accum::Replace,
                         view(ld, m, m).transpose(),
                         view(w, m, n),
                         1.0,
                     );
                     for j in 0..n {
-                        let s: f64 = self.tmp[j * m..(j + 1) * m].iter().map(|v| v * v).sum();
+                        let s: f64 = self.w2[j * m..(j + 1) * m].iter().map(|v| v * v).sum();
                         self.var[j * dx + dd] = s;
                     }
                 }
             }
         }
-        for j in 0..n {
-            let s: f64 = self.a[j * m..(j + 1) * m].iter().map(|v| v * v).sum();
+        let h = if post.whitened { w } else { &*t.k };
+        for ((wc, hc), v) in w
+            .chunks_exact(m)
+            .zip(h.chunks_exact(m))
+            .zip(self.var.chunks_exact_mut(dx))
+        {
+            let s: f64 = wc.iter().zip(hc).map(|(a, b)| a * b).sum();
             let base = post.variance - s;
-            for v in &mut self.var[j * dx..(j + 1) * dx] {
-                *v += base;
-            }
+            v.iter_mut().for_each(|v| *v += base);
         }
     }
 
@@ -282,8 +366,26 @@ impl ConditionalWorkspace {
         grads: &mut ConditionalGrads,
         xbar: &mut [f64],
     ) {
+        let mut tape = std::mem::take(&mut self.tape);
+        self.backward_tape(post, n, &mut tape, mean_bar, var_bar, grads, xbar);
+        self.tape = tape;
+    }
+
+    /// [`Self::backward`] from the intermediates a [`Self::forward_tape`] stored in `tape`.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn backward_tape(
+        &mut self,
+        post: &Posterior,
+        n: usize,
+        tape: &mut [f64],
+        mean_bar: &[f64],
+        var_bar: &[f64],
+        grads: &mut ConditionalGrads,
+        xbar: &mut [f64],
+    ) {
         let (m, dx) = (post.m, post.dx);
-        let w = if post.whitened { &self.a } else { &self.b };
+        let t = split_tape(post, self.cap, n, tape);
+        let (w, k) = (&*t.w, &*t.k);
         // μ = mᵀ W: m̄ᵀ += μ̄ Wᵀ, W̄ = m μ̄.
         gemm(
             view_mut(&mut grads.q_mean, dx, m),
@@ -301,6 +403,9 @@ impl ConditionalWorkspace {
         );
         match post.cov {
             CovarianceStructure::Diagonal => {
+                for (w2, &wv) in self.w2[..m * n].iter_mut().zip(w) {
+                    *w2 = wv * wv;
+                }
                 gemm(
                     view_mut(&mut grads.q_cov, dx, m),
                     Accum::Add,
@@ -309,25 +414,25 @@ impl ConditionalWorkspace {
                     1.0,
                 );
                 gemm(
-                    view_mut(&mut self.tmp, m, n),
+                    view_mut(&mut self.kbar, m, n),
                     Accum::Replace,
                     view(&post.q_cov, dx, m).transpose(),
                     view(var_bar, dx, n),
                     1.0,
                 );
-                for ((wb, &t), &wv) in self.wbar[..m * n]
+                for ((wb, &s), &wv) in self.wbar[..m * n]
                     .iter_mut()
-                    .zip(&self.tmp[..m * n])
-                    .zip(&w[..m * n])
+                    .zip(&self.kbar[..m * n])
+                    .zip(w)
                 {
-                    *wb += 2.0 * wv * t;
+                    *wb += 2.0 * wv * s;
                 }
             }
             CovarianceStructure::Full => {
                 for dd in 0..dx {
                     let ld = &post.q_cov[dd * m * m..(dd + 1) * m * m];
                     gemm(
-                        view_mut(&mut self.tmp, m, n),
+                        view_mut(&mut self.w2, m, n),
                         Accum::Replace,
                         view(ld, m, m).transpose(),
                         view(w, m, n),
@@ -335,7 +440,7 @@ impl ConditionalWorkspace {
                     );
                     for j in 0..n {
                         let s = 2.0 * var_bar[j * dx + dd];
-                        for v in &mut self.tmp[j * m..(j + 1) * m] {
+                        for v in &mut self.w2[j * m..(j + 1) * m] {
                             *v *= s;
                         }
                     }
@@ -343,7 +448,7 @@ impl ConditionalWorkspace {
                         view_mut(&mut self.wbar, m, n),
                         Accum::Add,
                         view(ld, m, m),
-                        view(&self.tmp, m, n),
+                        view(&self.w2, m, n),
                         1.0,
                     );
                     let gl = &mut grads.q_cov[dd * m * m..(dd + 1) * m * m];
@@ -351,72 +456,60 @@ impl ConditionalWorkspace {
                         view_mut(gl, m, m),
                         Accum::Add,
                         view(w, m, n),
-                        view(&self.tmp, m, n).transpose(),
+                        view(&self.w2, m, n).transpose(),
                         1.0,
                     );
                 }
             }
         }
-        // base = σ_f² − Σ A²: Ā = −2 A β̄.
-        for j in 0..n {
-            let bb: f64 = var_bar[j * dx..(j + 1) * dx].iter().sum();
+        // base = σ_f² − Σ H⊙W with β̄ = Σ_d σ̄²_d: whitened (H = W) W̄ −= 2β̄W;
+        // unwhitened (H = K) W̄ −= β̄K and K̄ = −β̄W.
+        for (j, vb) in var_bar[..dx * n].chunks_exact(dx).enumerate() {
+            let bb: f64 = vb.iter().sum();
             self.base_bar[j] = bb;
             grads.variance += bb;
         }
-        if post.whitened {
-            for j in 0..n {
-                let s = -2.0 * self.base_bar[j];
-                for (wb, &a) in self.wbar[j * m..(j + 1) * m]
-                    .iter_mut()
-                    .zip(&self.a[j * m..(j + 1) * m])
-                {
-                    *wb += s * a;
-                }
-            }
-        } else {
-            // W = L⁻ᵀA: C = L⁻¹W̄, Ā = C − 2Aβ̄, L̄ −= W Cᵀ.
-            solve_lower(&post.l, m, &mut self.wbar, n);
-            gemm(
-                view_mut(&mut grads.lbar, m, m),
-                Accum::Add,
-                view(&self.b, m, n),
-                view(&self.wbar, m, n).transpose(),
-                -1.0,
-            );
-            for j in 0..n {
-                let s = -2.0 * self.base_bar[j];
-                for (wb, &a) in self.wbar[j * m..(j + 1) * m]
-                    .iter_mut()
-                    .zip(&self.a[j * m..(j + 1) * m])
-                {
-                    *wb += s * a;
+        let kbar = &mut self.kbar[..m * n];
+        for (j, &bb) in self.base_bar[..n].iter().enumerate() {
+            let cols = j * m..(j + 1) * m;
+            let (wbc, wc, kc, kbc) = (&mut self.wbar[cols.clone()], &w[cols.clone()], &k[cols.clone()], &mut kbar[cols]);
+            if post.whitened {
+                let s = -2.0 * bb;
+                wbc.iter_mut().zip(wc).for_each(|(wb, &wv)| *wb += s * wv);
+                kbc.fill(0.0);
+            } else {
+                for (((wb, kb), &wv), &kv) in wbc.iter_mut().zip(kbc.iter_mut()).zip(wc).zip(kc) {
+                    *wb -= bb * kv;
+                    *kb = -bb * wv;
                 }
             }
         }
-        // wbar holds Ā. A = L⁻¹K: K̄ = L⁻ᵀĀ, L̄ −= K̄ Aᵀ.
-        solve_lower_transpose(&post.l, m, &mut self.wbar, n);
+        // W = G K: K̄ += Gᵀ W̄, Ḡ += W̄ Kᵀ.
         gemm(
-            view_mut(&mut grads.lbar, m, m),
+            view_mut(kbar, m, n),
+            Accum::Add,
+            view(&post.g, m, m).transpose(),
+            view(&self.wbar, m, n),
+            1.0,
+        );
+        gemm(
+            view_mut(&mut grads.gbar, m, m),
             Accum::Add,
             view(&self.wbar, m, n),
-            view(&self.a, m, n).transpose(),
-            -1.0,
+            view(k, m, n).transpose(),
+            1.0,
         );
         let inv_var = 1.0 / post.variance;
         let mut sv = 0.0;
-        for ((kb, &k), &kd) in self.wbar[..m * n]
-            .iter_mut()
-            .zip(&self.k[..m * n])
-            .zip(&self.kd[..m * n])
-        {
-            sv += *kb * k;
+        for ((kb, &kv), &kd) in kbar.iter_mut().zip(k).zip(&*t.kd) {
+            sv += *kb * kv;
             *kb *= kd;
         }
         grads.variance += sv * inv_var;
         kernel::cross_cov_backward(
-            &self.wbar[..m * n],
+            kbar,
             &post.zt,
-            &self.xs[..post.d * n],
+            t.xs,
             &post.inv_len,
             dx,
             &mut grads.zbar_t,

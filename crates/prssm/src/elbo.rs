@@ -22,10 +22,9 @@ use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
 use serde::{Deserialize, Serialize};
 
-use crate::conditional::{ConditionalGrads, ConditionalWorkspace, Posterior};
+use crate::conditional::{self, ConditionalGrads, ConditionalWorkspace, Posterior};
 use crate::kernel;
 use crate::kl::kl_divergence;
-use crate::linalg::cholesky_backward;
 use crate::objective::{Objective, ObjectiveError, Window};
 use crate::params::{ConfigError, ModelConfig, ParamGrads, Parametrization, Params};
 
@@ -217,6 +216,10 @@ pub struct Elbo {
     data: TrainingData,
     options: ElboOptions,
 }
+
+/// Memory for the per-step intermediates of one chunk of windows (bytes); longer windows are
+/// processed in segments whose forward steps are recomputed in the backward pass.
+pub const TAPE_BUDGET_BYTES: usize = 512 << 20;
 
 struct ChunkOut {
     nll: f64,
@@ -465,7 +468,7 @@ impl Elbo {
             .iter_mut()
             .zip(cond.q_cov.iter().zip(&kl.q_cov))
             .for_each(|(a, (b, c))| *a += b + c);
-        let mut kbar = cholesky_backward(&post.l, &mut cond.lbar, m);
+        let mut kbar = post.kmm_grad(&mut cond.gbar);
         if let Some(kk) = &kl.kmm {
             kbar.iter_mut().zip(kk).for_each(|(a, b)| *a += b);
         }
@@ -605,24 +608,43 @@ impl Elbo {
             }
             acc * lik_scale
         };
-        // Forward.
-        for t in 0..t_max {
+        // Per-step intermediates for the reverse mode: steps of segment `t / seg` share the
+        // tape; the forward pass leaves the last segment in it, earlier segments are
+        // recomputed from the stored states (identical arithmetic, so identical values).
+        let tape_step = conditional::tape_len(post, n);
+        let n_steps = t_max.saturating_sub(1);
+        let seg = (TAPE_BUDGET_BYTES / (8 * tape_step.max(1))).clamp(1, n_steps.max(1));
+        let mut tape = vec![0.0; seg.min(n_steps) * tape_step];
+        // Standard deviations √(σ² + σ_x² + δ) of every step, `(T − 1) × D_x × N`.
+        let mut sds = vec![0.0; n_steps * step];
+        let propagate = |ws: &mut ConditionalWorkspace,
+                         tape: &mut [f64],
+                         xs: &mut [f64],
+                         sds: &mut [f64],
+                         t: usize| {
             let (cur, next) = xs.split_at_mut((t + 1) * step);
             let x = &cur[t * step..];
-            nll += likelihood(x, t, None, &mut vy_bar);
-            if t + 1 < t_max {
-                let na = active[t + 1];
-                fill_input(&mut ws, x, t, na);
-                ws.forward(post, na);
-                let e = &eps[t * step..];
-                let xn = &mut next[..step];
-                for c in 0..na {
-                    for (dd, v) in vx.iter().enumerate() {
-                        let i = c * dx + dd;
-                        let sd = (ws.var[i] + v + jit).sqrt();
-                        xn[i] = x[i] + ws.mean[i] + sd * e[i];
-                    }
+            let na = active[t + 1];
+            fill_input(ws, x, t, na);
+            ws.forward_tape(post, na, tape);
+            let e = &eps[t * step..];
+            let xn = &mut next[..step];
+            let sd_t = &mut sds[t * step..(t + 1) * step];
+            for c in 0..na {
+                for (dd, v) in vx.iter().enumerate() {
+                    let i = c * dx + dd;
+                    let sd = (ws.var[i] + v + jit).sqrt();
+                    sd_t[i] = sd;
+                    xn[i] = x[i] + ws.mean[i] + sd * e[i];
                 }
+            }
+        };
+        // Forward.
+        for t in 0..t_max {
+            nll += likelihood(&xs[t * step..(t + 1) * step], t, None, &mut vy_bar);
+            if t < n_steps {
+                let slot = (t % seg) * tape_step;
+                propagate(&mut ws, &mut tape[slot..slot + tape_step], &mut xs, &mut sds, t);
             }
         }
         // Backward.
@@ -630,33 +652,43 @@ impl Elbo {
         let mut vx_bar = vec![0.0; dx];
         let mut mean_bar = vec![0.0; step];
         let mut var_bar = vec![0.0; step];
+        let last_seg = n_steps.saturating_sub(1) / seg;
         for t in (0..t_max).rev() {
-            let x = &xs[t * step..(t + 1) * step];
-            if t + 1 < t_max {
+            if t < n_steps {
+                let s = t / seg;
+                if s != last_seg && (t + 1) % seg == 0 {
+                    // Recompute segment s (steps s·seg ..= t) into the tape; the states it
+                    // rewrites come out identical.
+                    for r in s * seg..=t {
+                        let slot = (r % seg) * tape_step;
+                        propagate(&mut ws, &mut tape[slot..slot + tape_step], &mut xs, &mut sds, r);
+                    }
+                }
                 let na = active[t + 1];
-                fill_input(&mut ws, x, t, na);
-                ws.forward(post, na);
                 let e = &eps[t * step..];
+                let sd_t = &sds[t * step..];
                 for c in 0..na {
                     for dd in 0..dx {
                         let i = c * dx + dd;
-                        let sd = (ws.var[i] + vx[dd] + jit).sqrt();
+                        let sd = sd_t[i];
                         mean_bar[i] = xbar[i];
                         let vb = xbar[i] * e[i] / (2.0 * sd);
                         var_bar[i] = vb;
                         vx_bar[dd] += vb;
                     }
                 }
-                ws.backward(
+                let slot = (t % seg) * tape_step;
+                ws.backward_tape(
                     post,
                     na,
+                    &mut tape[slot..slot + tape_step],
                     &mean_bar[..dx * na],
                     &var_bar[..dx * na],
                     &mut cond,
                     &mut xbar,
                 );
             }
-            likelihood(x, t, Some(&mut xbar), &mut vy_bar);
+            likelihood(&xs[t * step..(t + 1) * step], t, Some(&mut xbar), &mut vy_bar);
         }
         let mut init_mean = vec![0.0; nb * dx];
         let mut init_std = vec![0.0; nb * dx];

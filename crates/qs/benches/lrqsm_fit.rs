@@ -64,15 +64,23 @@ fn data() -> (Vec<f64>, Vec<f64>) {
 fn bench(c: &mut Criterion) {
     let (x, y) = data();
     let features: Vec<String> = PUBLISHED_NAMES.iter().map(|s| s.to_string()).collect();
-    let targets: Vec<String> = ["F_x", "F_y", "M_x", "M_y", "M_z"].map(String::from).to_vec();
+    let targets: Vec<String> = ["F_x", "F_y", "M_x", "M_y", "M_z"]
+        .map(String::from)
+        .to_vec();
     let opts = EnetOptions::default();
     let mut g = c.benchmark_group("lrqsm");
     g.sample_size(10);
     g.bench_function("fit_5_outputs_240640x11_cv10_100lambda", |b| {
         b.iter(|| {
             fit_enet_cv(
-                Columns { names: &features, data: &x },
-                Columns { names: &targets, data: &y },
+                Columns {
+                    names: &features,
+                    data: &x,
+                },
+                Columns {
+                    names: &targets,
+                    data: &y,
+                },
                 &opts,
             )
             .unwrap()

@@ -302,9 +302,9 @@ impl Moments {
                     *r += xa * yv;
                 }
             }
-            for t in 0..m {
-                self.sy[t] += ys[t];
-                self.yty[t] += ys[t] * ys[t];
+            for ((sy, yty), yv) in self.sy.iter_mut().zip(&mut self.yty).zip(ys.iter()) {
+                *sy += yv;
+                *yty += yv * yv;
             }
         }
         self.n += rows.len();
@@ -485,8 +485,14 @@ pub fn fit_enet_cv(
     let mut shift_y = vec![0.0; m];
     if opts.intercept {
         for i in 0..n {
-            shift_x.iter_mut().zip(&x[i * p..]).for_each(|(s, v)| *s += v);
-            shift_y.iter_mut().zip(&y[i * m..]).for_each(|(s, v)| *s += v);
+            shift_x
+                .iter_mut()
+                .zip(&x[i * p..])
+                .for_each(|(s, v)| *s += v);
+            shift_y
+                .iter_mut()
+                .zip(&y[i * m..])
+                .for_each(|(s, v)| *s += v);
         }
         shift_x.iter_mut().for_each(|s| *s /= n as f64);
         shift_y.iter_mut().for_each(|s| *s /= n as f64);
@@ -631,7 +637,12 @@ fn original_scale(pr: &Standardized, t: usize, w: &[f64], b: &mut [f64]) -> f64 
     for (j, bj) in b.iter_mut().enumerate() {
         *bj = w[j] / pr.scale[j];
     }
-    pr.mean_y[t] - pr.mean_x.iter().zip(b.iter()).map(|(a, c)| a * c).sum::<f64>()
+    pr.mean_y[t]
+        - pr.mean_x
+            .iter()
+            .zip(b.iter())
+            .map(|(a, c)| a * c)
+            .sum::<f64>()
 }
 
 /// Σ (y − b₀ − xᵀb)² over the rows of `h` (shifted coordinates), expanded in its moments.

@@ -172,8 +172,19 @@ mod tests {
         assert!((lmax - 1.2).abs() < 1e-15);
         let lambdas = lambda_grid(lmax, 1e-3, 7);
         let mut coefs = vec![0.0; lambdas.len() * p];
-        let conv = Convergence { tol: 1e-15, max_sweeps: 100 };
-        let st = solve_path(&g, &c, &lambdas, alpha, conv, &mut CdWorkspace::new(p), &mut coefs);
+        let conv = Convergence {
+            tol: 1e-15,
+            max_sweeps: 100,
+        };
+        let st = solve_path(
+            &g,
+            &c,
+            &lambdas,
+            alpha,
+            conv,
+            &mut CdWorkspace::new(p),
+            &mut coefs,
+        );
         assert_eq!(st.unconverged, 0);
         for (k, l) in lambdas.iter().enumerate() {
             for j in 0..p {
@@ -181,7 +192,10 @@ mod tests {
                 assert!((coefs[k * p + j] - want).abs() < 1e-15);
             }
         }
-        assert!(coefs[..p].iter().all(|&w| w.abs() < 1e-15), "zero at lambda_max");
+        assert!(
+            coefs[..p].iter().all(|&w| w.abs() < 1e-15),
+            "zero at lambda_max"
+        );
     }
 
     #[test]

@@ -55,7 +55,9 @@ pub enum QsError {
         name: String,
     },
     /// Fewer rows than folds.
-    #[error("{rows} rows cannot be split into {folds} cross-validation folds (need at least 2 rows per fold)")]
+    #[error(
+        "{rows} rows cannot be split into {folds} cross-validation folds (need at least 2 rows per fold)"
+    )]
     TooFewRows {
         /// Rows available.
         rows: usize,
@@ -106,7 +108,9 @@ pub enum QsError {
         message: String,
     },
     /// A model file has a format version this build cannot read.
-    #[error("{path}: model format version {found} is not supported (this build reads version {supported})")]
+    #[error(
+        "{path}: model format version {found} is not supported (this build reads version {supported})"
+    )]
     ModelVersion {
         /// File.
         path: PathBuf,

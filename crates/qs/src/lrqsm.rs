@@ -67,7 +67,13 @@ pub fn fit_dataset(
         mean: stats.mean_y.to_vec(),
         std: stats.std_y.to_vec(),
     };
-    Ok(LrqsmModel::new(fit, *opts, Some(set), Some(scaling), source))
+    Ok(LrqsmModel::new(
+        fit,
+        *opts,
+        Some(set),
+        Some(scaling),
+        source,
+    ))
 }
 
 /// Root-mean-square errors per output, raw units (N, N·mm) and standardized.
@@ -131,7 +137,10 @@ pub fn predict_dataset(
     let n_t = ds.n_samples();
     let x = trajectory_features(&ds.trajectories, set);
     let mut standardized = vec![0.0; x.len() / set.len() * m];
-    for (row, out) in x.chunks_exact(set.len()).zip(standardized.chunks_exact_mut(m)) {
+    for (row, out) in x
+        .chunks_exact(set.len())
+        .zip(standardized.chunks_exact_mut(m))
+    {
         model.predict_row(row, mode, out);
     }
     let raw: Vec<f64> = standardized
@@ -205,7 +214,11 @@ impl DatasetPrediction {
                 &[self.n_trajectories],
                 NpyData::Bool((0..self.n_trajectories).map(|k| k < self.n_train).collect()),
             )
-            .add("output_names", &[m], NpyData::Str(self.output_names.clone()))
+            .add(
+                "output_names",
+                &[m],
+                NpyData::Str(self.output_names.clone()),
+            )
             .add("intercept", &[], NpyData::Bool(vec![self.intercept]));
         for (name, r) in [("train", &self.rmse_train), ("test", &self.rmse_test)] {
             if let Some(r) = r {

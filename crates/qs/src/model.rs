@@ -168,7 +168,8 @@ impl LrqsmModel {
             path: path.to_path_buf(),
             message,
         };
-        let value: serde_json::Value = serde_json::from_str(text).map_err(|e| bad(e.to_string()))?;
+        let value: serde_json::Value =
+            serde_json::from_str(text).map_err(|e| bad(e.to_string()))?;
         match value.get("kind").and_then(|k| k.as_str()) {
             Some(MODEL_KIND) => {}
             other => {
@@ -216,7 +217,11 @@ impl LrqsmModel {
                 return Err(format!("{field} has {len} entries, expected {p}"));
             }
         }
-        if let Some(j) = fit.feature_scale.iter().position(|s| !(*s > 0.0 && s.is_finite())) {
+        if let Some(j) = fit
+            .feature_scale
+            .iter()
+            .position(|s| !(*s > 0.0 && s.is_finite()))
+        {
             return Err(format!("fit.feature_scale[{j}] is not positive"));
         }
         let m = fit.targets.len();
@@ -237,7 +242,8 @@ impl LrqsmModel {
         }
         for (t, (path, ch)) in fit.targets.iter().zip(&self.chosen).enumerate() {
             let nl = path.lambdas.len();
-            let rows_ok = |rows: &Vec<Vec<f64>>| rows.len() == nl && rows.iter().all(|r| r.len() == p);
+            let rows_ok =
+                |rows: &Vec<Vec<f64>>| rows.len() == nl && rows.iter().all(|r| r.len() == p);
             if nl == 0
                 || !rows_ok(&path.coef_path)
                 || !rows_ok(&path.coef_path_standardized)

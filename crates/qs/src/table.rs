@@ -85,7 +85,10 @@ pub fn fit_table(
         return Err(QsError::InvalidOption {
             name: "targets",
             value: String::new(),
-            reason: format!("name at least one of the columns {}", table.names.join(", ")),
+            reason: format!(
+                "name at least one of the columns {}",
+                table.names.join(", ")
+            ),
         });
     }
     let y = select(table, targets, "target")?;

@@ -15,7 +15,10 @@ fn reference() -> NpzReader {
 
 fn max_abs_diff(a: &[f64], b: &[f64]) -> f64 {
     assert_eq!(a.len(), b.len());
-    a.iter().zip(b).map(|(u, v)| (u - v).abs()).fold(0.0, f64::max)
+    a.iter()
+        .zip(b)
+        .map(|(u, v)| (u - v).abs())
+        .fold(0.0, f64::max)
 }
 
 #[test]
@@ -45,8 +48,14 @@ fn matches_scikit_learn_reference() {
         ..EnetOptions::default()
     };
     let fit = fit_enet_cv(
-        Columns { names: &names, data: &x },
-        Columns { names: &target, data: &y },
+        Columns {
+            names: &names,
+            data: &x,
+        },
+        Columns {
+            names: &target,
+            data: &y,
+        },
         &opts,
     )
     .unwrap();
@@ -70,7 +79,10 @@ fn matches_scikit_learn_reference() {
     assert_eq!(t.index_1se, index_1se);
     assert_eq!(t.index_chosen, index_1se);
     assert!(max_abs_diff(t.coef(), &coef_1se) < 1e-6, "coef_1se");
-    assert!(max_abs_diff(&t.coef_path[index_min], &coef_min) < 1e-6, "coef_min");
+    assert!(
+        max_abs_diff(&t.coef_path[index_min], &coef_min) < 1e-6,
+        "coef_min"
+    );
     // No standardization, no intercept: both scales agree and the intercept is zero.
     assert_eq!(t.coef_path, t.coef_path_standardized);
     assert!(t.intercept_path.iter().all(|&b| b == 0.0));

@@ -15,7 +15,11 @@ fn names(k: usize, prefix: &str) -> Vec<String> {
 /// Published features of smooth random inputs and two noisy linear targets.
 fn problem(seed: u64) -> (Vec<f64>, Vec<f64>, usize) {
     let inputs = common::smooth_inputs(12, 150, 0.04, seed);
-    let x: Vec<f64> = inputs.iter().flatten().flat_map(|u| published_features(u)).collect();
+    let x: Vec<f64> = inputs
+        .iter()
+        .flatten()
+        .flat_map(published_features)
+        .collect();
     let n = x.len() / 11;
     let noise = common::normals(2 * n, seed + 1);
     let y = (0..n)
@@ -32,8 +36,14 @@ fn problem(seed: u64) -> (Vec<f64>, Vec<f64>, usize) {
 
 fn fit(x: &[f64], y: &[f64], opts: &EnetOptions) -> Result<flapssm_qs::cv::EnetCvFit, QsError> {
     fit_enet_cv(
-        Columns { names: &names(x.len() / (y.len() / 2), "x"), data: x },
-        Columns { names: &names(2, "y"), data: y },
+        Columns {
+            names: &names(x.len() / (y.len() / 2), "x"),
+            data: x,
+        },
+        Columns {
+            names: &names(2, "y"),
+            data: y,
+        },
         opts,
     )
 }
@@ -42,18 +52,31 @@ fn fit(x: &[f64], y: &[f64], opts: &EnetOptions) -> Result<flapssm_qs::cv::EnetC
 fn path_satisfies_kkt_on_independently_standardized_data() {
     let (x, y, n) = problem(3);
     let p = 11;
-    let opts = EnetOptions { tol: 1e-13, ..EnetOptions::default() };
+    let opts = EnetOptions {
+        tol: 1e-13,
+        ..EnetOptions::default()
+    };
     let f = fit(&x, &y, &opts).unwrap();
     // Two-pass means and population stds, computed here.
-    let mean: Vec<f64> = (0..p).map(|j| (0..n).map(|i| x[i * p + j]).sum::<f64>() / n as f64).collect();
+    let mean: Vec<f64> = (0..p)
+        .map(|j| (0..n).map(|i| x[i * p + j]).sum::<f64>() / n as f64)
+        .collect();
     let sd: Vec<f64> = (0..p)
-        .map(|j| ((0..n).map(|i| (x[i * p + j] - mean[j]).powi(2)).sum::<f64>() / n as f64).sqrt())
+        .map(|j| {
+            ((0..n)
+                .map(|i| (x[i * p + j] - mean[j]).powi(2))
+                .sum::<f64>()
+                / n as f64)
+                .sqrt()
+        })
         .collect();
     for j in 0..p {
         assert!((f.feature_center[j] - mean[j]).abs() <= 1e-12 * (1.0 + mean[j].abs()));
         assert!((f.feature_scale[j] / sd[j] - 1.0).abs() < 1e-12);
     }
-    let z: Vec<f64> = (0..n * p).map(|k| (x[k] - mean[k % p]) / sd[k % p]).collect();
+    let z: Vec<f64> = (0..n * p)
+        .map(|k| (x[k] - mean[k % p]) / sd[k % p])
+        .collect();
     for (t, path) in f.targets.iter().enumerate() {
         let ym = (0..n).map(|i| y[2 * i + t]).sum::<f64>() / n as f64;
         for (l, &lambda) in path.lambdas.iter().enumerate() {
@@ -63,7 +86,9 @@ fn path_satisfies_kkt_on_independently_standardized_data() {
             for i in 0..n {
                 let zi = &z[i * p..(i + 1) * p];
                 let r = y[2 * i + t] - ym - zi.iter().zip(w).map(|(a, b)| a * b).sum::<f64>();
-                g.iter_mut().zip(zi).for_each(|(gj, zj)| *gj += zj * r / n as f64);
+                g.iter_mut()
+                    .zip(zi)
+                    .for_each(|(gj, zj)| *gj += zj * r / n as f64);
             }
             let l1 = lambda * opts.l1_ratio;
             for j in 0..p {
@@ -73,14 +98,26 @@ fn path_satisfies_kkt_on_independently_standardized_data() {
                 } else {
                     (gj.abs() - l1).max(0.0)
                 };
-                assert!(viol < 1e-9, "target {t} λ#{l} feature {j}: KKT violation {viol}");
+                assert!(
+                    viol < 1e-9,
+                    "target {t} λ#{l} feature {j}: KKT violation {viol}"
+                );
                 // Original scale and intercept follow from w.
-                assert!((path.coef_path[l][j] - w[j] / sd[j]).abs() < 1e-12 * (1.0 + (w[j] / sd[j]).abs()));
+                assert!(
+                    (path.coef_path[l][j] - w[j] / sd[j]).abs()
+                        < 1e-12 * (1.0 + (w[j] / sd[j]).abs())
+                );
             }
             let b0 = ym - (0..p).map(|j| mean[j] * path.coef_path[l][j]).sum::<f64>();
             assert!((path.intercept_path[l] - b0).abs() < 1e-9 * (1.0 + b0.abs()));
         }
-        assert_eq!(path.coef_path_standardized[0].iter().filter(|w| w.abs() > 1e-14).count(), 0);
+        assert_eq!(
+            path.coef_path_standardized[0]
+                .iter()
+                .filter(|w| w.abs() > 1e-14)
+                .count(),
+            0
+        );
     }
 }
 
@@ -92,18 +129,33 @@ fn invariant_to_feature_units_and_target_offset() {
     let p = 11;
     let scale: Vec<f64> = (0..p).map(|j| 10f64.powi(j as i32 % 5 - 2)).collect();
     let shift: Vec<f64> = (0..p).map(|j| 100.0 * (j as f64 - 5.0)).collect();
-    let x2: Vec<f64> = (0..n * p).map(|k| scale[k % p] * x[k] + shift[k % p]).collect();
+    let x2: Vec<f64> = (0..n * p)
+        .map(|k| scale[k % p] * x[k] + shift[k % p])
+        .collect();
     let y2: Vec<f64> = y.iter().map(|v| v + 3.0).collect();
-    let opts = EnetOptions { tol: 1e-13, folds: FoldLayout::Random { seed: 9 }, ..EnetOptions::default() };
+    let opts = EnetOptions {
+        tol: 1e-13,
+        folds: FoldLayout::Random { seed: 9 },
+        ..EnetOptions::default()
+    };
     let a = fit(&x, &y, &opts).unwrap();
     let b = fit(&x2, &y2, &opts).unwrap();
     for (ta, tb) in a.targets.iter().zip(&b.targets) {
         for l in 0..ta.lambdas.len() {
             assert!((ta.lambdas[l] / tb.lambdas[l] - 1.0).abs() < 1e-9);
-            assert!((ta.cv_mse_mean[l] / tb.cv_mse_mean[l] - 1.0).abs() < 1e-7, "cv mse at {l}");
+            assert!(
+                (ta.cv_mse_mean[l] / tb.cv_mse_mean[l] - 1.0).abs() < 1e-7,
+                "cv mse at {l}"
+            );
             for j in 0..p {
-                let (wa, wb) = (ta.coef_path_standardized[l][j], tb.coef_path_standardized[l][j]);
-                assert!((wa - wb).abs() < 1e-8, "w at λ#{l} feature {j}: {wa} vs {wb}");
+                let (wa, wb) = (
+                    ta.coef_path_standardized[l][j],
+                    tb.coef_path_standardized[l][j],
+                );
+                assert!(
+                    (wa - wb).abs() < 1e-8,
+                    "w at λ#{l} feature {j}: {wa} vs {wb}"
+                );
                 let (ba, bb) = (ta.coef_path[l][j], tb.coef_path[l][j] * scale[j]);
                 assert!((ba - bb).abs() < 1e-8 * (1.0 + ba.abs()));
             }
@@ -147,33 +199,63 @@ fn bad_input_is_named() {
     assert!(e.contains("'x7'") && e.contains("constant"), "{e}");
     let (x, y, _) = problem(4);
     let e = fit(&x[..9 * 11], &y[..18], &opts).unwrap_err();
-    assert!(matches!(e, QsError::TooFewRows { rows: 9, folds: 10 }), "{e}");
+    assert!(
+        matches!(e, QsError::TooFewRows { rows: 9, folds: 10 }),
+        "{e}"
+    );
     let (x, _, n) = problem(4);
     let flat = vec![1.0; 2 * n];
     let e = fit(&x, &flat, &opts).unwrap_err().to_string();
     assert!(e.contains("'y0'") && e.contains("constant"), "{e}");
-    let e = fit(&x, &flat, &EnetOptions { l1_ratio: 0.0, ..opts }).unwrap_err().to_string();
+    let e = fit(
+        &x,
+        &flat,
+        &EnetOptions {
+            l1_ratio: 0.0,
+            ..opts
+        },
+    )
+    .unwrap_err()
+    .to_string();
     assert!(e.contains("l1_ratio"), "{e}");
 }
 
 #[test]
 fn seeded_random_folds_are_reproducible() {
     let (x, y, _) = problem(6);
-    let opts = EnetOptions { folds: FoldLayout::Random { seed: 42 }, ..EnetOptions::default() };
+    let opts = EnetOptions {
+        folds: FoldLayout::Random { seed: 42 },
+        ..EnetOptions::default()
+    };
     assert_eq!(fit(&x, &y, &opts).unwrap(), fit(&x, &y, &opts).unwrap());
 }
 
 fn model() -> LrqsmModel {
     let (x, y, _) = problem(8);
     let features: Vec<String> = PUBLISHED_NAMES.iter().map(|s| s.to_string()).collect();
-    let opts = EnetOptions { rule: LambdaRule::Min, ..EnetOptions::default() };
+    let opts = EnetOptions {
+        rule: LambdaRule::Min,
+        ..EnetOptions::default()
+    };
     let f = fit_enet_cv(
-        Columns { names: &features, data: &x },
-        Columns { names: &names(2, "y"), data: &y },
+        Columns {
+            names: &features,
+            data: &x,
+        },
+        Columns {
+            names: &names(2, "y"),
+            data: &y,
+        },
         &opts,
     )
     .unwrap();
-    LrqsmModel::new(f, opts, Some(flapssm_wing::features::FeatureSet::Published), None, "test")
+    LrqsmModel::new(
+        f,
+        opts,
+        Some(flapssm_wing::features::FeatureSet::Published),
+        None,
+        "test",
+    )
 }
 
 #[test]
@@ -201,20 +283,31 @@ fn model_file_round_trip_and_validation() {
 
     let mut v: serde_json::Value = serde_json::to_value(&m).unwrap();
     v["chosen"][0]["coef"][3] = 99.0.into();
-    let e = LrqsmModel::from_json(&v.to_string(), &path).unwrap_err().to_string();
+    let e = LrqsmModel::from_json(&v.to_string(), &path)
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("chosen[0]"), "{e}");
 
     let mut v: serde_json::Value = serde_json::to_value(&m).unwrap();
     v["fit"]["targets"][1]["cv_mse_se"] = serde_json::json!([1.0]);
-    let e = LrqsmModel::from_json(&v.to_string(), &path).unwrap_err().to_string();
+    let e = LrqsmModel::from_json(&v.to_string(), &path)
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("fit.targets[1]"), "{e}");
 
     let mut v: serde_json::Value = serde_json::to_value(&m).unwrap();
     v.as_object_mut().unwrap().remove("options");
-    let e = LrqsmModel::from_json(&v.to_string(), &path).unwrap_err().to_string();
+    let e = LrqsmModel::from_json(&v.to_string(), &path)
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("options"), "{e}");
 
-    let e = LrqsmModel::from_json("{\"kind\": \"other\"}", &path).unwrap_err().to_string();
+    let e = LrqsmModel::from_json("{\"kind\": \"other\"}", &path)
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("kind"), "{e}");
-    assert!(matches!(LrqsmModel::load(&dir.path().join("none.json")), Err(QsError::Io { .. })));
+    assert!(matches!(
+        LrqsmModel::load(&dir.path().join("none.json")),
+        Err(QsError::Io { .. })
+    ));
 }

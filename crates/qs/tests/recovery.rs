@@ -12,11 +12,13 @@ fn recovers_known_coefficients_within_noise() {
     let x: Vec<f64> = inputs
         .iter()
         .flatten()
-        .flat_map(|u| published_features(u))
+        .flat_map(published_features)
         .collect();
     let n = x.len() / p;
     // True model: a few features zero (elastic-net can keep them at zero).
-    let beta = [0.08, 0.35, 0.0, -0.12, 0.05, 0.02, -0.03, 0.0, 0.06, 0.01, -0.04];
+    let beta = [
+        0.08, 0.35, 0.0, -0.12, 0.05, 0.02, -0.03, 0.0, 0.06, 0.01, -0.04,
+    ];
     let b0 = 0.7;
     let sigma = 0.3;
     let noise = common::normals(n, 11);
@@ -32,8 +34,14 @@ fn recovers_known_coefficients_within_noise() {
         ..EnetOptions::default()
     };
     let fit = fit_enet_cv(
-        Columns { names: &names, data: &x },
-        Columns { names: &target, data: &y },
+        Columns {
+            names: &names,
+            data: &x,
+        },
+        Columns {
+            names: &target,
+            data: &y,
+        },
         &opts,
     )
     .unwrap();
@@ -48,7 +56,13 @@ fn recovers_known_coefficients_within_noise() {
     // The CV-chosen (min-MSE) coefficients are within 3 SE of the truth.
     for j in 0..p {
         let d = (t.coef()[j] - beta[j]).abs();
-        eprintln!("{:>22}: true {:+.4} fit {:+.4} (|d| = {:.2} SE)", names[j], beta[j], t.coef()[j], d / se[j]);
+        eprintln!(
+            "{:>22}: true {:+.4} fit {:+.4} (|d| = {:.2} SE)",
+            names[j],
+            beta[j],
+            t.coef()[j],
+            d / se[j]
+        );
         assert!(d < 3.0 * se[j], "feature {j}: {d} > 3 SE = {}", 3.0 * se[j]);
     }
     // The CV minimum is close to the noise variance.

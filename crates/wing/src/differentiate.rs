@@ -352,7 +352,7 @@ mod tests {
             sg.apply(&x, 0.004, &mut o, &mut o2, &mut o3),
             Err(DifferentiateError::TooShort { .. })
         ));
-        let x = vec![0.0; 100];
+        let x = vec![0.0; 300];
         assert!(matches!(
             sg.apply(&x, 0.004, &mut o, &mut o2, &mut o3),
             Err(DifferentiateError::LengthMismatch { .. })

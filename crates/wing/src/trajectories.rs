@@ -440,7 +440,7 @@ pub fn default_n_train(n: usize) -> usize {
     if n > 512 {
         512
     } else {
-        let n_test = (n * 36).div_ceil(548).max(usize::from(n >= 2));
+        let n_test = (n * 36).div_ceil(548).min(n.saturating_sub(1));
         n - n_test
     }
 }

@@ -25,11 +25,13 @@ const LAGS: [usize; 20] = [
     0, 1, 2, 3, 4, 6, 8, 10, 13, 16, 20, 25, 30, 36, 43, 50, 60, 70, 85, 100,
 ];
 
+/// Small noise-free dataset with a flat stroke plane (deviation ψ = 0; see the module docs).
 fn dataset(fidelity: Fidelity) -> (Dataset, Vec<f64>) {
     let trajectories = GeneratorConfig {
         n_trajectories: N_TRAJ,
         n_train: N_TRAIN,
         seed: SEED,
+        max_deviation_deg: 0.0,
         ..Default::default()
     };
     let freqs = trajectories
@@ -49,18 +51,24 @@ fn dataset(fidelity: Fidelity) -> (Dataset, Vec<f64>) {
     (simulate_dataset(&cfg, &|| {}).unwrap(), freqs)
 }
 
-/// Regressor rows: `history` = false → [1, 11 features]; true → [1, (11 features + 7 inputs)
-/// at every lag in LAGS].
+/// Regressor rows. QS: [1, 11 features(t)]. History: [1, 11 features(t), 7 inputs(t)] and, at
+/// every lag τ of LAGS, the 11 features(t − τ) and |v(t)|·g(t − τ) with
+/// g = [|v|, AoA|v|, AoA²|v|, AoA³|v|, α̇, a_x, a_y] — the Duhamel form of a circulatory force,
+/// ρU(t)·∫h(τ)Γ_qs(t − τ)dτ, made linear in the coefficients.
 fn regressors(inputs: &[[f64; 7]], k: usize, history: bool, out: &mut Vec<f64>) {
     out.clear();
     out.push(1.0);
-    let lags: &[usize] = if history { &LAGS } else { &[0] };
-    for &lag in lags {
+    out.extend_from_slice(&published_features(&inputs[k]));
+    if !history {
+        return;
+    }
+    out.extend_from_slice(&inputs[k]);
+    let speed = inputs[k][1];
+    for &lag in &LAGS[1..] {
         let u = &inputs[k - lag];
         out.extend_from_slice(&published_features(u));
-        if history {
-            out.extend_from_slice(u);
-        }
+        let [aoa, v, a_x, a_y, _, alpha_dot, _] = *u;
+        out.extend([v, aoa * v, aoa * aoa * v, aoa * aoa * aoa * v, alpha_dot, a_x, a_y].map(|g| speed * g));
     }
 }
 
@@ -119,7 +127,7 @@ fn fit(ds: &Dataset, history: bool) -> Fit {
     let yt = Mat::from_fn(n_rows, 5, |i, c| targets[i][c]);
     let mut g = x.transpose() * &x;
     let ridge = if history {
-        1e-4 * n_rows as f64
+        1e-7 * n_rows as f64
     } else {
         1e-10 * n_rows as f64
     };

@@ -11,6 +11,7 @@
 //! | [`authority`] | Fig. 5: HDR contours and modes, per-pair scatter, summary circle grid |
 //! | [`wing3d`] | Fig. 2C: 3-D wing-motion sketches (chord lines along the path, LE dotted) |
 //! | [`training`] | training curves |
+//! | [`sysid`] | system identification: test-part prediction with ±2σ band |
 
 use std::path::{Path, PathBuf};
 use std::sync::Once;
@@ -22,6 +23,7 @@ use crate::error::{AnalysisError, Result};
 
 pub mod authority;
 pub mod errors;
+pub mod sysid;
 pub mod timeseries;
 pub mod training;
 pub mod wing3d;

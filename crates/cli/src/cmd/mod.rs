@@ -5,6 +5,7 @@ pub mod dataset;
 pub mod model;
 pub mod predict;
 pub mod qs;
+pub mod sysid;
 pub mod train;
 pub mod trajectories;
 

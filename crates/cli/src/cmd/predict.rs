@@ -79,7 +79,11 @@ fn run_dataset(args: PredictArgs) -> anyhow::Result<()> {
         .with_context(|| format!("loading model {}", args.model.display()))?;
     let ds = flapssm_data::Dataset::load(ds_path)
         .with_context(|| format!("loading dataset {}", ds_path.display()))?;
-    let (dx, dy, du) = (model.config.n_state, model.config.n_output, model.config.n_input);
+    let (dx, dy, du) = (
+        model.config.n_state,
+        model.config.n_output,
+        model.config.n_input,
+    );
     if du != 7 || dy != 5 {
         bail!(
             "{}: model has D_u = {du}, D_y = {dy}; a flapssm dataset has 7 inputs and 5 outputs",
@@ -91,8 +95,13 @@ fn run_dataset(args: PredictArgs) -> anyhow::Result<()> {
     let mut y = Vec::new();
     for (i, traj) in ds.trajectories.iter().enumerate() {
         let seq = super::train::trajectory_sequence(traj);
-        let p = predict_raw(&model, &seq, args.particles, args.seed.wrapping_add(i as u64))
-            .with_context(|| format!("{}: trajectory {i}", ds_path.display()))?;
+        let p = predict_raw(
+            &model,
+            &seq,
+            args.particles,
+            args.seed.wrapping_add(i as u64),
+        )
+        .with_context(|| format!("{}: trajectory {i}", ds_path.display()))?;
         out[0].extend(p.output_mean);
         out[1].extend(p.output_var);
         out[2].extend(p.latent_mean);

@@ -189,8 +189,7 @@ pub fn run(args: TrainArgs) -> anyhow::Result<()> {
         .context("progress bar template")?
         .progress_chars("=> "),
     );
-    let mut progress = |e: &TrainEvent<'_>| {
-        match e {
+    let mut progress = |e: &TrainEvent<'_>| match e {
         TrainEvent::Step {
             step,
             total_steps,
@@ -204,7 +203,7 @@ pub fn run(args: TrainArgs) -> anyhow::Result<()> {
         }
         TrainEvent::Epoch(r) => {
             let f = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.4}"));
-            bar.println(format!(
+            say(format!(
                 "epoch {:>4}: -ELBO {:.5e}  train RMSE {}  val RMSE {}{}",
                 r.epoch,
                 r.mean_loss,
@@ -218,18 +217,17 @@ pub fn run(args: TrainArgs) -> anyhow::Result<()> {
             reason,
             lr_scale,
             retry,
-        } => bar.println(format!(
+        } => say(format!(
             "warning: step {step} rejected ({reason}); step undone, learning rate scaled to {lr_scale:.3e} (retry {retry})"
         )),
         TrainEvent::Checkpoint { path, step } => {
-            bar.println(format!("checkpoint at step {step} -> {}", path.display()))
+            say(format!("checkpoint at step {step} -> {}", path.display()))
         }
-        TrainEvent::Interrupted { step } => bar.println(format!(
+        TrainEvent::Interrupted { step } => say(format!(
             "interrupted at step {step}; continue with --resume (checkpoint {})",
             ck_path.display()
         )),
         _ => {}
-    }
     };
     println!(
         "{}: {} training / {} validation trajectories; D_x {}, M {}, {} particles, {:?}",

@@ -34,10 +34,20 @@ pub fn run(args: TrajectoriesArgs) -> anyhow::Result<()> {
         ..GeneratorConfig::default()
     };
     let ds = kinematics_dataset(&cfg).context("generating trajectories")?;
-    ds.save(&args.out).with_context(|| format!("writing dataset {}", args.out.display()))?;
+    ds.save(&args.out)
+        .with_context(|| format!("writing dataset {}", args.out.display()))?;
     let counts: Vec<String> = Family::ALL
         .iter()
-        .map(|f| format!("{} {}", f.label(), ds.trajectories.iter().filter(|t| t.family == f.label()).count()))
+        .map(|f| {
+            format!(
+                "{} {}",
+                f.label(),
+                ds.trajectories
+                    .iter()
+                    .filter(|t| t.family == f.label())
+                    .count()
+            )
+        })
         .collect();
     println!(
         "wrote {}: {} trajectories ({} train) × {} samples at dt = {} s, seed {}; families: {}; {:.2} s",

@@ -13,7 +13,11 @@ pub fn smooth_inputs(n_traj: usize, n_t: usize, dt_s: f64, seed: u64) -> Vec<Vec
         (0..3)
             .map(|_| {
                 let w = std::f64::consts::TAU * rng.random_range(0.1..0.8);
-                (amp * rng.random_range(0.3..1.0), w, rng.random_range(0.0..6.3))
+                (
+                    amp * rng.random_range(0.3..1.0),
+                    w,
+                    rng.random_range(0.0..6.3),
+                )
             })
             .collect()
     };
@@ -100,7 +104,9 @@ pub fn spd_inverse(a: &[f64], k: usize) -> Vec<f64> {
 /// SE_j = σ̂ sqrt([(X_cᵀX_c)⁻¹]_jj), σ̂² = SSE / (n − p − 1), X_c the centred design.
 pub fn ols(x: &[f64], y: &[f64], p: usize) -> (f64, Vec<f64>, Vec<f64>) {
     let n = y.len();
-    let mx: Vec<f64> = (0..p).map(|j| (0..n).map(|i| x[i * p + j]).sum::<f64>() / n as f64).collect();
+    let mx: Vec<f64> = (0..p)
+        .map(|j| (0..n).map(|i| x[i * p + j]).sum::<f64>() / n as f64)
+        .collect();
     let my = y.iter().sum::<f64>() / n as f64;
     let mut a = vec![0.0; p * p];
     let mut b = vec![0.0; p];
@@ -114,7 +120,9 @@ pub fn ols(x: &[f64], y: &[f64], p: usize) -> (f64, Vec<f64>, Vec<f64>) {
         }
     }
     let inv = spd_inverse(&a, p);
-    let beta: Vec<f64> = (0..p).map(|j| (0..p).map(|k| inv[j * p + k] * b[k]).sum()).collect();
+    let beta: Vec<f64> = (0..p)
+        .map(|j| (0..p).map(|k| inv[j * p + k] * b[k]).sum())
+        .collect();
     let b0 = my - (0..p).map(|j| mx[j] * beta[j]).sum::<f64>();
     let sse: f64 = (0..n)
         .map(|i| {

@@ -234,11 +234,7 @@ impl QuasiSteadySection {
             kin.rotation_rate_rad_s,
             &coeffs,
         );
-        if self.params.added_mass {
-            circ.add(added_mass(&self.geom, kin))
-        } else {
-            circ
-        }
+        circ.add(added_mass_loads(&self.geom, &self.params, kin))
     }
 }
 

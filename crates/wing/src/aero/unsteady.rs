@@ -23,7 +23,7 @@
 //! three off the model equals L0.
 
 use super::quasi_steady::{
-    QuasiSteadyParams, added_mass, circulatory_loads, translational_coefficients,
+    QuasiSteadyParams, added_mass_loads, circulatory_loads, translational_coefficients,
 };
 use super::{SectionGeometry, SectionKinematics, SectionLoads, SectionModel, SectionModelFactory};
 use serde::{Deserialize, Serialize};
@@ -266,11 +266,7 @@ impl SectionModel for UnsteadySection {
             self.g_prev[1],
             self.g_prev[2],
         ];
-        if p.quasi_steady.added_mass {
-            circ.add(added_mass(&self.geom, kin))
-        } else {
-            circ
-        }
+        circ.add(added_mass_loads(&self.geom, &p.quasi_steady, kin))
     }
 }
 

@@ -183,6 +183,14 @@ impl Ldvm {
         self.diag = LdvmDiagnostics::default();
     }
 
+    /// Sets U_ref (m/s, > 0 and finite; other values are ignored) for the LESP criterion and
+    /// amalgamation from the next step on.
+    pub fn set_reference_speed(&mut self, u_ref_m_s: f64) {
+        if u_ref_m_s.is_finite() && u_ref_m_s > 0.0 {
+            self.p.u_ref_m_s = u_ref_m_s;
+        }
+    }
+
     /// The free vortices.
     pub fn wake(&self) -> &Wake {
         &self.wake
@@ -269,7 +277,14 @@ impl Ldvm {
                     let (x, z) = self.wake.pos(i);
                     [le[0] + (x - le[0]) / 3.0, le[1] + (z - le[1]) / 3.0]
                 }
-                _ => first_position(le, v_le, [tx, tz], dt_s, c),
+                _ => {
+                    // on the suction side, along the bisector of chord and normal (UNSflow's
+                    // half-step-downstream point at 45°, kept off the plate at small angles)
+                    let d = (0.5 * v_le[0].hypot(v_le[1]) * dt_s).max(self.p.core_radius_frac * c);
+                    let sn = lesp0.signum() * std::f64::consts::FRAC_1_SQRT_2;
+                    let k = d * std::f64::consts::FRAC_1_SQRT_2;
+                    [le[0] + k * tx + d * sn * nx, le[1] + k * tz + d * sn * nz]
+                }
             };
             self.unit_influence(p_lev, le, [tx, tz], [nx, nz], false);
             let (b0l, b1l) = (self.coef(0, Field::Lev), self.coef(1, Field::Lev));
@@ -290,7 +305,8 @@ impl Ldvm {
         let need = if g_lev != 0.0 { 2 } else { 1 };
         if self.wake.len() + need > self.wake.capacity() {
             let d0 = self.p.merge.unwrap_or_default().d0_chords * c;
-            self.wake.amalgamate(le, te, d0, 0.0, 0.0, self.p.max_vortices * 4 / 5);
+            self.wake
+                .amalgamate(le, te, d0, 0.0, 0.0, self.p.max_vortices * 4 / 5);
             while self.wake.len() + need > self.wake.capacity() {
                 self.wake.remove_weakest();
             }
@@ -413,13 +429,20 @@ impl Ldvm {
             .p
             .merge
             .filter(|m| self.step % m.interval_steps as u64 == 0);
-        if let Some(MergeParams { d0_chords, v0, near_chords, .. }) = merge {
+        if let Some(MergeParams {
+            d0_chords,
+            v0,
+            near_chords,
+            ..
+        }) = merge
+        {
             let v0_dim = v0 * self.p.u_ref_m_s / c;
             let (s, co) = plate.angle_rad.sin_cos();
             let le = [px - self.xp * co, pz - self.xp * s];
             let te = [le[0] + c * co, le[1] + c * s];
             let target = self.p.max_vortices * 4 / 5;
-            self.wake.amalgamate(le, te, d0_chords * c, near_chords * c, v0_dim, target);
+            self.wake
+                .amalgamate(le, te, d0_chords * c, near_chords * c, v0_dim, target);
         }
     }
 

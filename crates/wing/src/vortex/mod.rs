@@ -50,12 +50,16 @@
 //!
 //! # Strips along the span ([`StripLdvm`])
 //!
-//! See [`strip`].
+//! [`StripLdvmFactory`] implements [`crate::aero::SectionModelFactory`]: the blade-element
+//! integrator places one LDVM per strip; see [`strip`] for the section frame, the reference speed
+//! and the 3-D correction.
 
 mod ldvm;
+pub mod strip;
 mod wake;
 
 pub use ldvm::{Ldvm, LdvmDiagnostics, PlateState, SectionLoads};
+pub use strip::{StripLdvm, StripLdvmFactory, StripLdvmParams};
 pub use wake::{VortexKind, Wake};
 
 use serde::{Deserialize, Serialize};
@@ -137,8 +141,8 @@ impl Default for MergeParams {
 /// | `pivot_frac` | 0.15 | pitch axis x̂0 = x_p/c from the leading edge |
 /// | `rho_kg_m3` | 800 | fluid density ρ (mineral oil) |
 /// | `u_ref_m_s` | 0.37 | reference speed U_ref for LESP = B0/U_ref and amalgamation |
-/// | `n_chord` | 32 | chord collocation points (θ uniform in [0, π]; also the bound elements) |
-/// | `n_fourier` | 12 | Fourier terms B0..B_{n−1} |
+/// | `n_chord` | 24 | chord collocation points (θ uniform in [0, π]; also the bound elements) |
+/// | `n_fourier` | 10 | Fourier terms B0..B_{n−1} |
 /// | `lesp_crit` | Some(0.15) | critical LESP; `None` turns LEV shedding off |
 /// | `core_radius_frac` | 0.02 | Vatistas core radius r_c / c |
 /// | `suction_factor` | 1.0 | multiplies the leading-edge suction ρπcB0² |
@@ -146,7 +150,7 @@ impl Default for MergeParams {
 /// | `tev_decay_chords` | Some(40.0) | same for trailing-edge (wake) vortices |
 /// | `far_field_chords` | Some(12.0) | free vortices farther than this from the pivot are deleted |
 /// | `merge` | Some(default) | Spalart amalgamation, see [`MergeParams`] |
-/// | `max_vortices` | 160 | hard cap on free vortices (storage is allocated once) |
+/// | `max_vortices` | 110 | hard cap on free vortices (storage is allocated once) |
 ///
 /// LESP_crit: Ramesh et al. report 0.1–0.2 for Re 10³–10⁴; UNSflow uses 0.11 for a flat plate in
 /// the Eldredge pitch-up. The default 0.15 sits in the middle; 2-D models shed the LEV too readily
@@ -195,8 +199,8 @@ impl Default for LdvmParams {
             pivot_frac: 0.15,
             rho_kg_m3: 800.0,
             u_ref_m_s: 0.37,
-            n_chord: 32,
-            n_fourier: 12,
+            n_chord: 24,
+            n_fourier: 10,
             lesp_crit: Some(0.15),
             core_radius_frac: 0.02,
             suction_factor: 1.0,
@@ -204,7 +208,7 @@ impl Default for LdvmParams {
             tev_decay_chords: Some(40.0),
             far_field_chords: Some(12.0),
             merge: Some(MergeParams::default()),
-            max_vortices: 160,
+            max_vortices: 110,
         }
     }
 }
@@ -292,7 +296,11 @@ impl LdvmParams {
                 return bad("merge.v0", m.v0, "must be finite and >= 0");
             }
             if !(m.near_chords.is_finite() && m.near_chords >= 0.0) {
-                return bad("merge.near_chords", m.near_chords, "must be finite and >= 0");
+                return bad(
+                    "merge.near_chords",
+                    m.near_chords,
+                    "must be finite and >= 0",
+                );
             }
             if m.interval_steps == 0 {
                 return bad("merge.interval_steps", 0.0, "must be >= 1");

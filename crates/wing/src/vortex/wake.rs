@@ -219,7 +219,15 @@ impl Wake {
     /// (smallest measure first, any distance) while the count exceeds `target`. Never merges the
     /// newest TEV/LEV. Conserves Σ Γ.
     #[allow(clippy::too_many_arguments)]
-    pub(crate) fn amalgamate(&mut self, le: [f64; 2], te: [f64; 2], d0_m: f64, near_m: f64, v0_dim: f64, target: usize) {
+    pub(crate) fn amalgamate(
+        &mut self,
+        le: [f64; 2],
+        te: [f64; 2],
+        d0_m: f64,
+        near_m: f64,
+        v0_dim: f64,
+        target: usize,
+    ) {
         let n = self.len();
         if n < 2 {
             return;
@@ -250,7 +258,8 @@ impl Wake {
                     continue;
                 }
                 let dij = (self.x[i] - self.x[j]).hypot(self.z[i] - self.z[j]);
-                let m = (gi * gj).abs() / (gi + gj).abs() * dij / ((d0_m + di) * (d0_m + dj)).powf(1.5);
+                let m =
+                    (gi * gj).abs() / (gi + gj).abs() * dij / ((d0_m + di) * (d0_m + dj)).powf(1.5);
                 if m < best.0 {
                     best = (m, j as u32);
                 }
