@@ -23,6 +23,7 @@
 
 pub mod authority;
 pub mod cycles_avg;
+pub mod demo;
 pub mod error;
 pub mod kde;
 pub mod metrics;
@@ -30,6 +31,7 @@ pub mod pipeline;
 pub mod plots;
 pub mod report;
 pub mod stats;
+pub mod sweep;
 pub mod sysid;
 pub mod xcorr;
 

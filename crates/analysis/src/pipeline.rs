@@ -17,10 +17,11 @@
 //!   `start_sample` on, every trajectory (training and test), period = the cycle duration.
 
 use std::path::{Path, PathBuf};
+use std::sync::atomic::AtomicBool;
 
 use flapssm_data::{Dataset, OUTPUT_NAMES, Trajectory};
-use flapssm_prssm::train::derive_seed;
-use flapssm_prssm::train::fit::{FitError, predict_raw, training_record};
+use flapssm_prssm::train::fit::{FitError, FitOutcome, FitSpec, Preset, fit, predict_raw, training_record};
+use flapssm_prssm::train::{Budget, Checkpoint, TrainEvent, TrainHooks, derive_seed};
 use flapssm_prssm::{PrssmModel, Sequence};
 use flapssm_qs::{InterceptMode, LrqsmModel, QsError};
 use flapssm_wing::cycles::{CycleError, published_window};
@@ -396,7 +397,6 @@ pub struct ReportContext {
 /// One trajectory's tables for the analyses.
 struct Prepared {
     window: CycleWindow,
-    scales: CoefficientScales,
     measured_z: Vec<f64>,
     measured_c: Vec<f64>,
     prssm_z: Vec<f64>,
@@ -612,7 +612,6 @@ pub fn evaluate(
         let std_raw: Vec<f64> = pp[i].var.iter().map(|v| v.max(0.0).sqrt()).collect();
         prep.push(Prepared {
             window,
-            scales,
             measured_z: z(measured),
             measured_c: coef(measured)?,
             prssm_z: z(&pp[i].mean),
@@ -1461,4 +1460,173 @@ pub fn versions() -> Vec<(String, String)> {
             .into(),
         ),
     ]
+}
+
+/// PR-SSM training settings shared by the sweeps and the demo: a preset with overrides.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TrainingOptions {
+    /// Named preset (paper: D_x 12, M 100, 30 particles, batch 16, lr 0.03, 1000 epochs).
+    pub preset: Preset,
+    /// Latent dimension D_x.
+    pub dx: Option<usize>,
+    /// Inducing points M.
+    pub inducing: Option<usize>,
+    /// Particles per window (also used for the per-epoch evaluation rollouts).
+    pub particles: Option<usize>,
+    /// Epochs.
+    pub epochs: Option<u64>,
+    /// Windows per minibatch.
+    pub batch: Option<usize>,
+    /// Adam learning rate.
+    pub lr: Option<f64>,
+    /// Evaluate (best-model tracking) every this many epochs.
+    pub eval_every: Option<u64>,
+    /// Seed of initialization, shuffles and draws.
+    pub seed: u64,
+    /// Fraction of the training trajectories (the last ones) held out for best-model selection.
+    pub val_fraction: f64,
+    /// Checkpoint every this many epochs (0: only when interrupted).
+    pub checkpoint_every: u64,
+}
+
+impl Default for TrainingOptions {
+    /// The paper preset, no overrides, seed 0, 10 % validation, checkpoint every 10 epochs.
+    fn default() -> Self {
+        Self {
+            preset: Preset::Paper,
+            dx: None,
+            inducing: None,
+            particles: None,
+            epochs: None,
+            batch: None,
+            lr: None,
+            eval_every: None,
+            seed: 0,
+            val_fraction: 0.1,
+            checkpoint_every: 10,
+        }
+    }
+}
+
+impl TrainingOptions {
+    /// The fit specification for 7 inputs and 5 outputs.
+    pub fn spec(&self) -> FitSpec {
+        let mut spec = FitSpec::preset(self.preset, 7, 5);
+        if let Some(v) = self.dx {
+            spec.model.n_state = v;
+        }
+        if let Some(v) = self.inducing {
+            spec.model.n_inducing = v;
+        }
+        if let Some(v) = self.particles {
+            spec.particles = v;
+            spec.eval_particles = v;
+        }
+        if let Some(v) = self.epochs {
+            spec.train.budget = Budget::Epochs(v);
+        }
+        if let Some(v) = self.batch {
+            spec.train.batch_size = v;
+        }
+        if let Some(v) = self.lr {
+            spec.train.lr = v;
+        }
+        if let Some(v) = self.eval_every {
+            spec.train.eval_every = v;
+        }
+        spec.train.seed = self.seed;
+        spec.train.checkpoint_every = self.checkpoint_every;
+        spec
+    }
+
+    /// Splits training trajectories into (fit, validation): the last
+    /// `round(n · val_fraction)` (at most `n − 1`) validate.
+    ///
+    /// # Errors
+    /// [`PipelineError::Mismatch`] for a fraction outside [0, 1) or no trajectory.
+    pub fn split<'a>(
+        &self,
+        train: &'a [Trajectory],
+    ) -> Result<(&'a [Trajectory], &'a [Trajectory])> {
+        if !(0.0..1.0).contains(&self.val_fraction) || train.is_empty() {
+            return Err(PipelineError::Mismatch {
+                what: "training split".into(),
+                expected: "val_fraction in [0, 1) and at least one training trajectory".into(),
+                found: format!("{} of {} trajectories", self.val_fraction, train.len()),
+            });
+        }
+        let n_val = ((train.len() as f64 * self.val_fraction).round() as usize)
+            .min(train.len() - 1);
+        Ok(train.split_at(train.len() - n_val))
+    }
+}
+
+/// Trains a PR-SSM on `train` (split by [`TrainingOptions::split`]), reporting steps to
+/// `progress` (`set(step, total)`, one line per evaluated epoch), checkpointing to
+/// `checkpoint` and resuming from `resume`. Polls `stop` before every step.
+///
+/// # Errors
+/// [`PipelineError::Prssm`] for a failed fit, [`PipelineError::Interrupted`] when stopped.
+pub fn train_prssm(
+    train: &[Trajectory],
+    opts: &TrainingOptions,
+    checkpoint: Option<&Path>,
+    resume: Option<Checkpoint>,
+    progress: &dyn Progress,
+    stop: Option<&AtomicBool>,
+) -> Result<FitOutcome> {
+    let (fit_set, val_set) = opts.split(train)?;
+    let fit_seqs: Vec<Sequence> = fit_set.iter().map(trajectory_sequence).collect();
+    let val_seqs: Vec<Sequence> = val_set.iter().map(trajectory_sequence).collect();
+    let spec = opts.spec();
+    let mut on_event = |e: &TrainEvent<'_>| match e {
+        TrainEvent::Step {
+            step,
+            total_steps,
+            epoch,
+            loss,
+            ..
+        } => {
+            progress.set(step + 1, *total_steps);
+            progress.message(&format!("epoch {epoch} loss {loss:.3e}"));
+        }
+        TrainEvent::Epoch(r) => {
+            let f = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.4}"));
+            progress.println(&format!(
+                "epoch {:>4}: -ELBO {:.4e}  train RMSE {}  val RMSE {}{}",
+                r.epoch,
+                r.mean_loss,
+                f(r.train_rmse),
+                f(r.val_rmse),
+                if r.is_best { "  (best)" } else { "" }
+            ));
+        }
+        TrainEvent::Rejected { step, reason, .. } => {
+            progress.println(&format!("step {step} rejected ({reason}); retried"));
+        }
+        _ => {}
+    };
+    let out = fit(
+        &spec,
+        &fit_seqs,
+        &val_seqs,
+        TrainHooks {
+            evaluate: None,
+            progress: Some(&mut on_event),
+            stop,
+            checkpoint: checkpoint.map(Path::to_path_buf),
+        },
+        resume,
+    )
+    .map_err(|source| PipelineError::Prssm {
+        what: "training".into(),
+        source,
+    })?;
+    if out.outcome.interrupted {
+        return Err(PipelineError::Interrupted {
+            step: out.outcome.state.step,
+            checkpoint: checkpoint.map(Path::to_path_buf).unwrap_or_default(),
+        });
+    }
+    Ok(out)
 }

@@ -29,11 +29,22 @@ enum Command {
     Bench(cmd::bench::BenchArgs),
     /// Generate random wing trajectories (kinematics-only dataset).
     Trajectories(cmd::trajectories::TrajectoriesArgs),
+    /// Simulate the virtual robotic wing (L0/L1/L2 aerodynamics, sensor chain) into a dataset.
+    Simulate(cmd::simulate::SimulateArgs),
     /// Quasi-steady baseline (LRQSM): elastic net with cross-validation.
     Qs {
         #[command(subcommand)]
         command: cmd::qs::QsCommand,
     },
+    /// Evaluate a PR-SSM and an LRQSM on a dataset: metrics, authority, figures, report.
+    Evaluate(cmd::evaluate::EvaluateArgs),
+    /// PR-SSM sweeps: `run` one configuration (D_x or training-set size), `merge` results.
+    Sweep {
+        #[command(subcommand)]
+        command: cmd::sweep::SweepCommand,
+    },
+    /// The whole pipeline on a simulated wing (resumable; --full for the paper's configuration).
+    Demo(cmd::demo::DemoArgs),
     /// System identification on recorded data (Doerr et al. protocol): fit, open-loop test.
     Sysid(cmd::sysid::SysidArgs),
 }
@@ -48,7 +59,11 @@ fn main() {
         Command::Train(args) => cmd::train::run(args),
         Command::Bench(args) => cmd::bench::run(args),
         Command::Trajectories(args) => cmd::trajectories::run(args),
+        Command::Simulate(args) => cmd::simulate::run(args),
         Command::Qs { command } => cmd::qs::run(command),
+        Command::Evaluate(args) => cmd::evaluate::run(args),
+        Command::Sweep { command } => cmd::sweep::run(command),
+        Command::Demo(args) => cmd::demo::run(args),
         Command::Sysid(args) => cmd::sysid::run(args),
     };
     if let Err(err) = result {

@@ -6,7 +6,9 @@
 //!   (plus the per-evaluation K_mm factorization and KL);
 //! - `predict/len470_p30`: one 470-step open-loop prediction with 30 particles (one thread).
 //!
-//! Run: `cargo bench -p flapssm-prssm --bench engine`. The projected epoch time is printed.
+//! Run: `cargo bench -p flapssm-prssm --bench engine`. The projected epoch time is printed,
+//! from wall time and from CPU time (the latter is what idle cores would give on a shared,
+//! loaded machine).
 
 use std::hint::black_box;
 use std::time::Instant;
@@ -45,13 +47,23 @@ fn setup() -> (Elbo, Vec<f64>, ModelConfig, Params, Vec<f64>) {
     (elbo, theta, config, params, u)
 }
 
-/// FLOPs of one forward + backward transition step for N points (dominant terms): forward,
-/// recomputation and backward triangular solves (6 M²N), the two L̄ products (4 M²N),
-/// the kernel and its adjoint (12 M N D), mean/variance products (12 M D_x N).
+/// FLOPs of one forward + backward transition step for N points (dominant terms of the
+/// algorithm, prssm-notes §4): `W = G K`, `K̄ = Gᵀ W̄`, `Ḡ += W̄ Kᵀ` (6 M²N), the kernel
+/// distances and their two adjoint products (6 M D N), mean/variance products and their
+/// adjoints (12 M D_x N). Paper configuration, N = 480: 41 MFLOP.
 fn step_flops(n: usize) -> f64 {
     let (m, d, dx) = (100.0, 19.0, 12.0);
     let n = n as f64;
-    10.0 * m * m * n + 12.0 * m * n * d + 12.0 * m * dx * n
+    6.0 * m * m * n + 6.0 * m * n * d + 12.0 * m * dx * n
+}
+
+/// CPU time (user + system) of this process so far, seconds (Linux `/proc/self/stat`,
+/// 100 ticks per second); `None` elsewhere.
+fn cpu_seconds() -> Option<f64> {
+    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
+    let fields: Vec<&str> = stat.rsplit_once(')')?.1.split_whitespace().collect();
+    let ticks: f64 = fields.get(11)?.parse::<f64>().ok()? + fields.get(12)?.parse::<f64>().ok()?;
+    Some(ticks / 100.0)
 }
 
 fn bench(c: &mut Criterion) {
@@ -83,6 +95,8 @@ fn bench(c: &mut Criterion) {
             len: T,
         })
         .collect();
+    elbo.loss_and_grad(&theta, &batch, 99, &mut grad).unwrap();
+    let cpu0 = cpu_seconds();
     let mut times: Vec<f64> = (0..5)
         .map(|i| {
             let t0 = Instant::now();
@@ -90,16 +104,26 @@ fn bench(c: &mut Criterion) {
             t0.elapsed().as_secs_f64()
         })
         .collect();
+    let cpu = cpu_seconds().zip(cpu0).map(|(a, b)| (a - b) / 5.0);
     times.sort_by(f64::total_cmp);
     let tb = times[2];
     let epoch = 32.0 * tb;
     let gflops = step_flops(480) * (T - 1) as f64 / tb / 1e9;
     println!(
-        "minibatch (16 × 470 × 30) forward+backward: {tb:.3} s; projected epoch (512 seqs): {epoch:.2} s \
-         (authors: 81.8 s, {:.1}× faster); {gflops:.1} GFLOP/s; threads: {}",
+        "minibatch (16 × 470 × 30) forward+backward: {tb:.3} s (median of 5); projected epoch \
+         (512 seqs): {epoch:.2} s (authors: 81.8 s, {:.1}× faster); {gflops:.1} GFLOP/s; threads: {}",
         81.8 / epoch,
         rayon::current_num_threads()
     );
+    if let Some(cpu) = cpu {
+        let threads = rayon::current_num_threads() as f64;
+        println!(
+            "  CPU time per minibatch {cpu:.3} s → epoch on {threads} idle cores ≈ {:.2} s \
+             ({:.1} GFLOP/s per core)",
+            32.0 * cpu / threads,
+            step_flops(480) * (T - 1) as f64 / cpu / 1e9
+        );
+    }
     let zero = vec![0.0; 12];
     let mut g = c.benchmark_group("predict");
     g.bench_function("len470_p30", |b| {

@@ -19,9 +19,7 @@
 use faer::Accum;
 
 use crate::kernel::{self, KernelKind};
-use crate::linalg::{
-    cholesky_backward, cholesky_in_place, gemm, lower_inverse, view, view_mut,
-};
+use crate::linalg::{cholesky_backward, cholesky_in_place, gemm, lower_inverse, view, view_mut};
 use crate::objective::ObjectiveError;
 use crate::params::{CovarianceStructure, ModelConfig, Parametrization, Params};
 
@@ -144,13 +142,37 @@ impl Posterior {
                 gbar[j * m..j * m + j].fill(0.0);
             }
             let gt = view(&self.g, m, m).transpose();
-            gemm(view_mut(&mut t, m, m), Accum::Replace, gt, view(gbar, m, m), 1.0);
-            gemm(view_mut(&mut out, m, m), Accum::Replace, view(&t, m, m), gt, -1.0);
+            gemm(
+                view_mut(&mut t, m, m),
+                Accum::Replace,
+                gt,
+                view(gbar, m, m),
+                1.0,
+            );
+            gemm(
+                view_mut(&mut out, m, m),
+                Accum::Replace,
+                view(&t, m, m),
+                gt,
+                -1.0,
+            );
             cholesky_backward(&self.l, &mut out, m)
         } else {
             let g = view(&self.g, m, m);
-            gemm(view_mut(&mut t, m, m), Accum::Replace, g, view(gbar, m, m), 1.0);
-            gemm(view_mut(&mut out, m, m), Accum::Replace, view(&t, m, m), g, -1.0);
+            gemm(
+                view_mut(&mut t, m, m),
+                Accum::Replace,
+                g,
+                view(gbar, m, m),
+                1.0,
+            );
+            gemm(
+                view_mut(&mut out, m, m),
+                Accum::Replace,
+                view(&t, m, m),
+                g,
+                -1.0,
+            );
             out
         }
     }
@@ -472,7 +494,12 @@ impl ConditionalWorkspace {
         let kbar = &mut self.kbar[..m * n];
         for (j, &bb) in self.base_bar[..n].iter().enumerate() {
             let cols = j * m..(j + 1) * m;
-            let (wbc, wc, kc, kbc) = (&mut self.wbar[cols.clone()], &w[cols.clone()], &k[cols.clone()], &mut kbar[cols]);
+            let (wbc, wc, kc, kbc) = (
+                &mut self.wbar[cols.clone()],
+                &w[cols.clone()],
+                &k[cols.clone()],
+                &mut kbar[cols],
+            );
             if post.whitened {
                 let s = -2.0 * bb;
                 wbc.iter_mut().zip(wc).for_each(|(wb, &wv)| *wb += s * wv);

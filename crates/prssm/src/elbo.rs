@@ -215,10 +215,37 @@ pub struct Elbo {
     config: ModelConfig,
     data: TrainingData,
     options: ElboOptions,
+    tape_budget_bytes: usize,
+    tapes: TapePool,
+}
+
+/// Tape buffers kept between evaluations (fresh pages cost more than the arithmetic); the
+/// contents are always overwritten before they are read.
+#[derive(Debug, Default)]
+struct TapePool(std::sync::Mutex<Vec<Vec<f64>>>);
+
+impl Clone for TapePool {
+    fn clone(&self) -> Self {
+        Self::default()
+    }
+}
+
+impl TapePool {
+    fn take(&self, len: usize) -> Vec<f64> {
+        let mut pool = self.0.lock().unwrap_or_else(|e| e.into_inner());
+        let mut v = pool.pop().unwrap_or_default();
+        v.resize(len, 0.0);
+        v
+    }
+
+    fn put(&self, v: Vec<f64>) {
+        self.0.lock().unwrap_or_else(|e| e.into_inner()).push(v);
+    }
 }
 
 /// Memory for the per-step intermediates of one chunk of windows (bytes); longer windows are
 /// processed in segments whose forward steps are recomputed in the backward pass.
+/// Default of [`Elbo::with_tape_budget`].
 pub const TAPE_BUDGET_BYTES: usize = 512 << 20;
 
 struct ChunkOut {
@@ -281,6 +308,8 @@ impl Elbo {
             config,
             data,
             options,
+            tape_budget_bytes: TAPE_BUDGET_BYTES,
+            tapes: TapePool::default(),
         })
     }
 
@@ -292,6 +321,14 @@ impl Elbo {
     /// The options.
     pub fn options(&self) -> &ElboOptions {
         &self.options
+    }
+
+    /// Sets the memory for the per-step intermediates of one chunk of windows (bytes,
+    /// default [`TAPE_BUDGET_BYTES`]; at least one step is always stored). Results do not
+    /// depend on it; a smaller budget trades memory for forward recomputation.
+    pub fn with_tape_budget(mut self, bytes: usize) -> Self {
+        self.tape_budget_bytes = bytes;
+        self
     }
 
     /// The training data.
@@ -613,8 +650,8 @@ impl Elbo {
         // recomputed from the stored states (identical arithmetic, so identical values).
         let tape_step = conditional::tape_len(post, n);
         let n_steps = t_max.saturating_sub(1);
-        let seg = (TAPE_BUDGET_BYTES / (8 * tape_step.max(1))).clamp(1, n_steps.max(1));
-        let mut tape = vec![0.0; seg.min(n_steps) * tape_step];
+        let seg = (self.tape_budget_bytes / (8 * tape_step.max(1))).clamp(1, n_steps.max(1));
+        let mut tape = self.tapes.take(seg.min(n_steps) * tape_step);
         // Standard deviations √(σ² + σ_x² + δ) of every step, `(T − 1) × D_x × N`.
         let mut sds = vec![0.0; n_steps * step];
         let propagate = |ws: &mut ConditionalWorkspace,
@@ -644,7 +681,13 @@ impl Elbo {
             nll += likelihood(&xs[t * step..(t + 1) * step], t, None, &mut vy_bar);
             if t < n_steps {
                 let slot = (t % seg) * tape_step;
-                propagate(&mut ws, &mut tape[slot..slot + tape_step], &mut xs, &mut sds, t);
+                propagate(
+                    &mut ws,
+                    &mut tape[slot..slot + tape_step],
+                    &mut xs,
+                    &mut sds,
+                    t,
+                );
             }
         }
         // Backward.
@@ -661,7 +704,13 @@ impl Elbo {
                     // rewrites come out identical.
                     for r in s * seg..=t {
                         let slot = (r % seg) * tape_step;
-                        propagate(&mut ws, &mut tape[slot..slot + tape_step], &mut xs, &mut sds, r);
+                        propagate(
+                            &mut ws,
+                            &mut tape[slot..slot + tape_step],
+                            &mut xs,
+                            &mut sds,
+                            r,
+                        );
                     }
                 }
                 let na = active[t + 1];
@@ -688,7 +737,12 @@ impl Elbo {
                     &mut xbar,
                 );
             }
-            likelihood(&xs[t * step..(t + 1) * step], t, Some(&mut xbar), &mut vy_bar);
+            likelihood(
+                &xs[t * step..(t + 1) * step],
+                t,
+                Some(&mut xbar),
+                &mut vy_bar,
+            );
         }
         let mut init_mean = vec![0.0; nb * dx];
         let mut init_std = vec![0.0; nb * dx];
@@ -700,6 +754,7 @@ impl Elbo {
                 }
             }
         }
+        self.tapes.put(tape);
         ChunkOut {
             nll,
             cond,
@@ -751,5 +806,64 @@ impl Objective for Elbo {
             },
         )?;
         Ok(parts.loss)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::params::ParamInit;
+
+    /// Recomputing segments of the forward pass in the backward pass (small tape budgets)
+    /// gives bit-identical loss and gradient.
+    #[test]
+    fn tape_budget_does_not_change_results() {
+        let config = ModelConfig::new(3, 2, 2, 6);
+        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        let seqs = (0..3)
+            .map(|_| Sequence {
+                inputs: (0..13 * 2)
+                    .map(|_| StandardNormal.sample(&mut rng))
+                    .collect(),
+                outputs: (0..13 * 2)
+                    .map(|_| StandardNormal.sample(&mut rng))
+                    .collect(),
+            })
+            .collect();
+        let data = TrainingData::new(2, 2, seqs).unwrap();
+        let theta = Params::init(&config, &ParamInit::default(), 2).unconstrained(&config);
+        let batch: Vec<Window> = [(0, 0, 13), (1, 2, 9), (2, 1, 12)]
+            .iter()
+            .map(|&(sequence, start, len)| Window {
+                sequence,
+                start,
+                len,
+            })
+            .collect();
+        let mut opts = ElboOptions::paper(3);
+        opts.particles = 4;
+        opts.windows_per_task = 2;
+        let elbo = Elbo::new(config, data, opts).unwrap();
+        let step_bytes = 8 * conditional::tape_len(
+            &Posterior::new(
+                elbo.config(),
+                &Params::from_unconstrained(elbo.config(), &theta).unwrap(),
+            )
+            .unwrap(),
+            8,
+        );
+        let run = |e: &Elbo| {
+            let mut g = vec![0.0; theta.len()];
+            let loss = e.loss_and_grad(&theta, &batch, 11, &mut g).unwrap();
+            (loss, g)
+        };
+        let full = run(&elbo);
+        assert!(full.1.iter().any(|&v| v != 0.0));
+        for steps in [1, 3, 5] {
+            let e = elbo.clone().with_tape_budget(steps * step_bytes);
+            assert_eq!(run(&e), full, "{steps} steps per segment");
+        }
+        // A repeated evaluation reuses the pooled tapes.
+        assert_eq!(run(&elbo), full);
     }
 }

@@ -69,7 +69,7 @@ pub fn exp(x: f64) -> f64 {
     let r = (x - kf * LN2_HI) - kf * LN2_LO;
     let mut p = C[13];
     for &c in C[..13].iter().rev() {
-        p = p * r + c;
+        p = p.mul_add(r, c);
     }
     let k = kf as i64;
     let k1 = k >> 1;
@@ -118,22 +118,37 @@ pub fn cross_cov(
     kd: &mut [f64],
 ) {
     let m_n = zt.len() / d;
+    let (wide, narrow) = (m_n / 32 * 32, m_n / 8 * 8);
     for ((kc, kdc), x) in k
         .chunks_exact_mut(m_n)
         .zip(kd.chunks_exact_mut(m_n))
         .zip(xs.chunks_exact(d))
     {
-        kc.fill(0.0);
-        for j in 0..d {
-            let xj = x[j];
-            let zj = &zt[j * m_n..(j + 1) * m_n];
-            for (t, &z) in kc.iter_mut().zip(zj) {
-                let diff = z - xj;
-                *t += diff * diff;
-            }
+        for m0 in (0..wide).step_by(32) {
+            kc[m0..m0 + 32].copy_from_slice(&tau_block::<32>(zt, m_n, m0, x));
+        }
+        for m0 in (wide..narrow).step_by(8) {
+            kc[m0..m0 + 8].copy_from_slice(&tau_block::<8>(zt, m_n, m0, x));
+        }
+        for m in narrow..m_n {
+            kc[m] = tau_block::<1>(zt, m_n, m, x)[0];
         }
         apply_shape(kind, variance, matern_tau_jitter, kc, kdc);
     }
+}
+
+/// `τ(z_m, x)` for `m = m0..m0 + W` (independent SIMD accumulators for wide `W`).
+#[inline(always)]
+fn tau_block<const W: usize>(zt: &[f64], m_n: usize, m0: usize, x: &[f64]) -> [f64; W] {
+    let mut acc = [0.0; W];
+    for (j, &xj) in x.iter().enumerate() {
+        let z = &zt[j * m_n + m0..][..W];
+        for l in 0..W {
+            let diff = z[l] - xj;
+            acc[l] = diff.mul_add(diff, acc[l]);
+        }
+    }
+    acc
 }
 
 /// Replaces `τ` in `k` by `σ_f² g(τ)` and writes `σ_f² g'(τ)` into `kd` (one vectorized
@@ -261,13 +276,20 @@ mod tests {
         let grid = (0..200_000).map(|i| -745.0 + 1454.0 * i as f64 / 200_000.0);
         let small = (0..20_000).map(|i| (i as f64 - 10_000.0) * 1e-5);
         let random = (0..200_000).map(|_| rng.random_range(-40.0..1.0));
-        for x in grid.chain(small).chain(random).chain([0.0, -0.0, 1e-300, -1e-300]) {
+        for x in grid
+            .chain(small)
+            .chain(random)
+            .chain([0.0, -0.0, 1e-300, -1e-300])
+        {
             let (ours, libm) = (exp(x), x.exp());
             if libm >= f64::MIN_POSITIVE {
                 worst = worst.max(ulps(ours, libm));
             } else {
                 // Subnormal range: absolute error of a few smallest subnormals.
-                assert!((ours - libm).abs() <= 4.0 * 5e-324, "{x}: {ours:e} {libm:e}");
+                assert!(
+                    (ours - libm).abs() <= 4.0 * 5e-324,
+                    "{x}: {ours:e} {libm:e}"
+                );
             }
         }
         assert!(worst <= 1, "max error {worst} ulp");

@@ -1,6 +1,8 @@
 //! Properties of the fit: optimality (KKT) on independently standardized data, invariance
 //! under affine changes of units, fold layouts, errors, the model file.
 
+#![allow(clippy::needless_range_loop)] // index arithmetic mirrors the equations
+
 mod common;
 
 use flapssm_qs::QsError;

@@ -127,7 +127,7 @@ fn fit(ds: &Dataset, history: bool) -> Fit {
     let yt = Mat::from_fn(n_rows, 5, |i, c| targets[i][c]);
     let mut g = x.transpose() * &x;
     let ridge = if history {
-        1e-7 * n_rows as f64
+        1e-4 * n_rows as f64
     } else {
         1e-10 * n_rows as f64
     };

@@ -427,9 +427,9 @@ fn hovering_sanity() {
             (1.0..=1.8).contains(&cl),
             "{fidelity:?}: cycle-mean C_L = {cl}"
         );
-        assert!(
-            (1.8..=2.8).contains(&cn_mid),
-            "{fidelity:?}: mid-stroke C_N = {cn_mid}"
-        );
+        // L1 sits below QS at mid-stroke: at r_cp a ±80° half-stroke is only ≈ 8 chords of
+        // travel, so the Wagner and LEV lags and the inflow have not settled.
+        let band = if fidelity == Fidelity::L0 { 2.3..=2.6 } else { 1.5..=2.6 };
+        assert!(band.contains(&cn_mid), "{fidelity:?}: mid-stroke C_N = {cn_mid}");
     }
 }

@@ -255,22 +255,30 @@ fn eldredge_run() -> ((f64, f64), (f64, f64)) {
             peak = (cl, t);
         }
     }
-    let (t_on, a_on) = onset.expect("the LEV must be shed");
+    (onset.expect("the LEV must be shed"), peak)
+}
+
+const ELDREDGE_T2: f64 = 1.0 + PI / 4.0 / 0.8;
+
+#[test]
+fn eldredge_pitch_up_sheds_lev_when_a0_exceeds_lesp_crit() {
+    let ((t_on, a_on), peak) = eldredge_run();
     println!(
         "LEV onset t* = {t_on:.3} (α = {a_on:.1}°), peak C_L = {:.3} at t* = {:.3}",
         peak.0, peak.1
     );
-    let t2 = 1.0 + PI / 4.0 / 0.8;
     assert!(
-        t_on > 1.0 && t_on < t2,
+        t_on > 1.0 && t_on < ELDREDGE_T2,
         "LEV onset at t* = {t_on} is outside the ramp"
     );
-    if std::env::var("FLAPSSM_CHECK_ELDREDGE_PEAK").is_ok() {
-        // Known gap (see docs/vortex-method.md): the apparent-mass spike at the ramp start gives
-        // C_L ≈ 6.6 and the lift during the LEV-shedding ramp is too low.
-        assert!((3.0..=5.0).contains(&peak.0), "peak C_L = {}", peak.0);
-        assert!(peak.1 > 1.0 && peak.1 < t2 + 0.2, "peak at t* = {}", peak.1);
-    }
+}
+
+#[test]
+#[ignore = "known gap (docs/vortex-method.md): apparent-mass spike C_L ≈ 6.6 at the ramp start, lift too low while the LEV is shed"]
+fn eldredge_pitch_up_peak_lift_during_ramp() {
+    let (_, (cl, t)) = eldredge_run();
+    assert!((3.0..=5.0).contains(&cl), "peak C_L = {cl}");
+    assert!(t > 1.0 && t < ELDREDGE_T2 + 0.2, "peak at t* = {t}");
 }
 
 /// 2-D hovering: surge ±A along X with the LE leading, 45° geometric AoA at mid-stroke, a 2ω

@@ -189,6 +189,7 @@ pub fn run(args: TrainArgs) -> anyhow::Result<()> {
         .context("progress bar template")?
         .progress_chars("=> "),
     );
+    let say = |line: String| bar.suspend(|| eprintln!("{line}"));
     let mut progress = |e: &TrainEvent<'_>| match e {
         TrainEvent::Step {
             step,

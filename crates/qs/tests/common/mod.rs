@@ -1,5 +1,5 @@
 //! Shared test helpers: smooth random wing inputs and a small dense solver.
-#![allow(dead_code)]
+#![allow(dead_code, clippy::needless_range_loop)]
 
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;

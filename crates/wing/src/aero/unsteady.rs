@@ -11,13 +11,16 @@
 //!    w ← w* + (w − w*)·exp(−Δθ/θ_w), Δθ = U·dt/r. All circulatory loads use the velocity
 //!    relative to the fluid, v − w; after a stroke reversal the wing moves back into the flow
 //!    it set in motion (wake capture).
-//! 2. **LEV lag** (Goman–Khrabrov type). The signed translational normal coefficient c_n
-//!    relaxes to its static value over τ_lev chords travelled:
+//! 2. **LEV lag** (Goman–Khrabrov type). The translational normal force is split into an
+//!    attached share cos²α_g (potential flow, lagged by Wagner) and an LEV share sin²α_g whose
+//!    signed coefficient c_n relaxes to its static value over τ_lev chords travelled:
 //!    c_n ← c_n* + (c_n − c_n*)·exp(−Δs_c/τ_lev), Δs_c = ∫U dt / c. It starts at 0 (no LEV).
-//! 3. **Wagner lag** (Jones-type 2-state, per load channel). With the circulatory input
-//!    u = L_qs/(ρU) (circulation-like, m²/s) and s = 2∫U dt/c (semichords),
-//!    dx_i/ds = −b_i x_i + u, L_c = ρU[(1 − A1 − A2)u + A1 b1 x1 + A2 b2 x2],
-//!    integrated exactly for u linear over a step; in s the states freeze when U → 0.
+//! 3. **Wagner lag** (Jones-type 2-state, per load channel N, T, M) on the attached share and the
+//!    rotational circulation. With the circulatory input u = L_qs/(ρU) (circulation-like, m²/s)
+//!    and s = 2∫U dt/c (semichords), dx_i/ds = −b_i x_i + u,
+//!    L_c = ρU[(1 − A1 − A2)u + A1 b1 x1 + A2 b2 x2], integrated exactly for u linear over a
+//!    step; in s the states freeze when U → 0. With the Wagner lag off, the whole translational
+//!    force takes the LEV path.
 //!
 //! Added mass uses the true kinematics, as in L0. Every effect can be switched off; with all
 //! three off the model equals L0.
@@ -76,13 +79,14 @@ pub struct UnsteadyParams {
     pub wagner_coefficients: WagnerCoefficients,
     /// LEV lag on the translational normal coefficient (true).
     pub lev_lag: bool,
-    /// LEV time constant τ_lev in chords travelled (1.5; revolving wings build their LEV within
+    /// LEV time constant τ_lev in chords travelled (2; revolving wings build their LEV within
     /// about 2 chords, airfoil dynamic stall 2–6).
     pub lev_time_constant_chords: f64,
     /// Induced inflow / wake state (true).
     pub inflow: bool,
-    /// Distance d_w of the lumped wake vortex, in chords (1.5). Gives a hovering inflow of
-    /// ≈ 0.13 U at C_N = 2.5, near the momentum-theory value.
+    /// Distance d_w of the lumped wake vortex, in chords (2). Steady inflow
+    /// w/U = C_N/(4π d_w) ≈ 0.1 at C_N = 2.5, below the momentum-theory hover value (≈ 0.2–0.3)
+    /// because the static Dickinson coefficients already contain the Robofly's mean inflow.
     pub inflow_distance_chords: f64,
     /// Relaxation angle θ_w of the inflow, in radians of wing travel (0.8 ≈ 0.1–0.3 of a
     /// cycle for stroke amplitudes 40–100°).
@@ -96,9 +100,9 @@ impl Default for UnsteadyParams {
             wagner: true,
             wagner_coefficients: WagnerCoefficients::default(),
             lev_lag: true,
-            lev_time_constant_chords: 1.5,
+            lev_time_constant_chords: 2.0,
             inflow: true,
-            inflow_distance_chords: 1.5,
+            inflow_distance_chords: 2.0,
             inflow_decay_rad: 0.8,
         }
     }
@@ -146,18 +150,28 @@ impl UnsteadySection {
     }
 }
 
-/// x(Δ) for dx/ds = −b x + u(s), u linear from u0 to u1 over Δ ≥ 0.
-fn foh_update(x: f64, b: f64, delta: f64, u0: f64, u1: f64) -> f64 {
-    let bd = b * delta;
-    let decay = (-bd).exp();
-    let e1 = -(-bd).exp_m1() / b;
-    // (Δ − E1)/(bΔ), by series when bΔ is small.
-    let ramp = if bd < 1e-4 {
-        delta * (0.5 - bd / 6.0)
-    } else {
-        (delta - e1) / bd
-    };
-    decay * x + u0 * e1 + (u1 - u0) * ramp
+/// Exact one-step propagator of dx/ds = −b x + u(s) for u linear from u0 to u1 over Δ ≥ 0:
+/// x(Δ) = e^{−bΔ}x0 + E1·u0 + R·(u1 − u0), E1 = (1 − e^{−bΔ})/b, R = (Δ − E1)/(bΔ).
+#[derive(Debug, Clone, Copy)]
+struct FohStep {
+    decay: f64,
+    e1: f64,
+    ramp: f64,
+}
+
+impl FohStep {
+    fn new(b: f64, delta: f64) -> Self {
+        let bd = b * delta;
+        let em1 = (-bd).exp_m1();
+        let e1 = -em1 / b;
+        // R by series when bΔ is small.
+        let ramp = if bd < 1e-4 { delta * (0.5 - bd / 6.0) } else { (delta - e1) / bd };
+        Self { decay: 1.0 + em1, e1, ramp }
+    }
+
+    fn apply(&self, x: f64, u0: f64, u1: f64) -> f64 {
+        self.decay * x + u0 * self.e1 + (u1 - u0) * self.ramp
+    }
 }
 
 impl SectionModel for UnsteadySection {
@@ -245,10 +259,11 @@ impl SectionModel for UnsteadySection {
         if p.wagner {
             let WagnerCoefficients { a1, b1, a2, b2 } = p.wagner_coefficients;
             let ds = 2.0 * travel_m / c;
+            let (step1, step2) = (FohStep::new(b1, ds), FohStep::new(b2, ds));
             for ch in 0..3 {
                 let x = &mut self.wagner_x[ch];
-                x[0] = foh_update(x[0], b1, ds, self.u_prev[ch], u[ch]);
-                x[1] = foh_update(x[1], b2, ds, self.u_prev[ch], u[ch]);
+                x[0] = step1.apply(x[0], self.u_prev[ch], u[ch]);
+                x[1] = step2.apply(x[1], self.u_prev[ch], u[ch]);
                 g[ch] = (1.0 - a1 - a2) * u[ch] + a1 * b1 * x[0] + a2 * b2 * x[1];
             }
         }

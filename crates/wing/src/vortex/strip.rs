@@ -128,9 +128,8 @@ impl SectionModel for StripLdvm {
         };
         let speed = kin.speed_m_s();
         let omega = kin.rotation_rate_rad_s;
-        let dt = if self.started {
-            dt_s
-        } else if dt_s.is_finite() && dt_s > 0.0 {
+        // the first step starts impulsively; its dt only sets the first TEV position
+        let dt = if self.started || (dt_s.is_finite() && dt_s > 0.0) {
             dt_s
         } else {
             1e-3

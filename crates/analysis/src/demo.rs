@@ -1,0 +1,480 @@
+//! The one-command demo: simulate the virtual wing, fit the LRQSM, train the PR-SSM, evaluate
+//! both, analyse, plot, write the report and `summary.json`.
+//!
+//! Stages and their outputs in the demo folder:
+//!
+//! | stage | output | depends on |
+//! |---|---|---|
+//! | `simulate` | `dataset.npz` | simulation config |
+//! | `lrqsm` | `lrqsm.json` | + LRQSM features and options |
+//! | `prssm` | `prssm.json`, `prssm.last.json` (checkpoint `prssm.ckpt.json`) | + training options |
+//! | `evaluate` | `eval/` (metrics, figures, `report.html`) | + evaluation options |
+//! | — | `summary.json` | everything |
+//!
+//! Resumable: `stages.json` records, per finished stage, a key (its configuration and those of
+//! the stages it depends on) and its wall time; a stage whose key matches and whose output
+//! exists is skipped. An interrupted training resumes from its checkpoint when the training key
+//! matches.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::AtomicBool;
+use std::time::Instant;
+
+use flapssm_data::{Dataset, OUTPUT_NAMES};
+use flapssm_prssm::PrssmModel;
+use flapssm_prssm::train::Checkpoint;
+use flapssm_qs::{EnetOptions, LrqsmModel};
+use flapssm_wing::features::FeatureSet;
+use flapssm_wing::virtual_wing::{SimulationConfig, simulate_dataset};
+use serde::{Deserialize, Serialize};
+
+use crate::pipeline::{
+    AuthorityFinding, EvalOptions, EvaluationReport, PipelineError, Progress, ReportContext,
+    Result, TrainingOptions, evaluate, load_json, save_json, train_prssm, versions,
+};
+use crate::stats::{Interval, median};
+
+/// Format tag of `summary.json`.
+pub const SUMMARY_FORMAT: &str = "flapssm-demo-summary";
+/// Target of the default configuration: PR-SSM test RMSE ≤ this × LRQSM's on every output.
+pub const RATIO_TARGET: f64 = 0.6;
+
+/// Everything that defines a demo run.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct DemoConfig {
+    /// Master seed (simulation, training, prediction draws).
+    pub seed: u64,
+    /// `"default"` or `"full"`.
+    pub name: String,
+    /// The virtual wing and its trajectories.
+    pub simulation: SimulationConfig,
+    /// LRQSM feature set.
+    pub lrqsm_features: FeatureSet,
+    /// LRQSM elastic-net options.
+    pub lrqsm: EnetOptions,
+    /// PR-SSM training.
+    pub training: TrainingOptions,
+    /// Evaluation.
+    pub evaluation: EvalOptions,
+}
+
+impl DemoConfig {
+    /// The default (short) configuration: 96 trajectories (80 train, 16 test) of 470 samples;
+    /// PR-SSM D_x 8, M 32, 10 particles, minibatches of 4 whole trajectories, Adam lr 0.05,
+    /// 600 epochs. Sized to finish within 15 minutes on 2 cores (see docs/demo.md).
+    pub fn default_for(seed: u64) -> Self {
+        let mut simulation = SimulationConfig::default();
+        simulation.trajectories.n_trajectories = 96;
+        simulation.trajectories.n_train = 80;
+        simulation.trajectories.seed = seed;
+        Self {
+            seed,
+            name: "default".into(),
+            simulation,
+            lrqsm_features: FeatureSet::Published,
+            lrqsm: EnetOptions::default(),
+            training: TrainingOptions {
+                dx: Some(8),
+                inducing: Some(32),
+                particles: Some(10),
+                epochs: Some(600),
+                batch: Some(4),
+                lr: Some(0.05),
+                eval_every: Some(25),
+                seed,
+                ..TrainingOptions::default()
+            },
+            evaluation: EvalOptions {
+                seed,
+                ..EvalOptions::default()
+            },
+        }
+    }
+
+    /// The paper's configuration: 548 trajectories (512 train, 36 test), D_x 12, M 100,
+    /// 30 particles, minibatches of 16, lr 0.03, 1000 epochs.
+    pub fn full(seed: u64) -> Self {
+        let mut simulation = SimulationConfig::default();
+        simulation.trajectories.seed = seed;
+        Self {
+            seed,
+            name: "full".into(),
+            simulation,
+            lrqsm_features: FeatureSet::Published,
+            lrqsm: EnetOptions::default(),
+            training: TrainingOptions {
+                seed,
+                ..TrainingOptions::default()
+            },
+            evaluation: EvalOptions {
+                seed,
+                ..EvalOptions::default()
+            },
+        }
+    }
+}
+
+/// Wall time of one stage.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct StageTiming {
+    /// Stage name.
+    pub stage: String,
+    /// Wall time when it ran (s).
+    pub wall_s: f64,
+    /// Whether this run skipped it (output up to date).
+    pub skipped: bool,
+}
+
+/// Headline numbers of a demo run (`summary.json`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct DemoSummary {
+    /// [`SUMMARY_FORMAT`].
+    pub format: String,
+    /// The configuration.
+    pub config: DemoConfig,
+    /// Training / test trajectories.
+    pub n_train: usize,
+    /// Test trajectories.
+    pub n_test: usize,
+    /// Output names.
+    pub outputs: Vec<String>,
+    /// PR-SSM test RMSE per output (σ units).
+    pub prssm_test_rmse: Vec<f64>,
+    /// LRQSM test RMSE per output (σ units).
+    pub lrqsm_test_rmse: Vec<f64>,
+    /// PR-SSM / LRQSM per output.
+    pub rmse_ratio: Vec<f64>,
+    /// [`RATIO_TARGET`].
+    pub ratio_target: f64,
+    /// Whether every ratio is ≤ the target.
+    pub ratio_target_met: bool,
+    /// Overall test RMSE (σ units) [PR-SSM, LRQSM].
+    pub overall_test_rmse: [f64; 2],
+    /// Half-stroke-average error intervals (coefficients, training + test) of the PR-SSM.
+    pub prssm_cycle_average_ci: Vec<Interval>,
+    /// Same for the LRQSM.
+    pub lrqsm_cycle_average_ci: Vec<Interval>,
+    /// AoA and a_x on the output states.
+    pub authority: Vec<AuthorityFinding>,
+    /// Median over the output states of AoA's median lag (cycles).
+    pub aoa_median_lag_cycles: f64,
+    /// Median over the output states of a_x's median lag (cycles).
+    pub a_x_median_lag_cycles: f64,
+    /// Stage timings.
+    pub timings: Vec<StageTiming>,
+    /// Wall time of this invocation (s).
+    pub total_wall_s: f64,
+    /// Versions.
+    pub versions: Vec<(String, String)>,
+    /// The evaluation report, relative to the demo folder.
+    pub report: String,
+}
+
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+struct StageRecord {
+    key: serde_json::Value,
+    wall_s: f64,
+}
+
+/// `stages.json`: finished stages.
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+struct Stages {
+    stages: BTreeMap<String, StageRecord>,
+}
+
+struct Runner<'a> {
+    dir: PathBuf,
+    stages: Stages,
+    timings: Vec<StageTiming>,
+    progress: &'a dyn Progress,
+}
+
+impl Runner<'_> {
+    fn path(&self) -> PathBuf {
+        self.dir.join("stages.json")
+    }
+
+    fn up_to_date(&self, stage: &str, key: &serde_json::Value, outputs: &[&Path]) -> bool {
+        self.stages.stages.get(stage).is_some_and(|r| &r.key == key)
+            && outputs.iter().all(|p| p.exists())
+    }
+
+    /// Runs `work` unless the stage is up to date; records its key and time.
+    fn stage<T>(
+        &mut self,
+        stage: &str,
+        key: &serde_json::Value,
+        outputs: &[&Path],
+        load: impl FnOnce() -> Result<T>,
+        work: impl FnOnce(&dyn Progress) -> Result<T>,
+    ) -> Result<T> {
+        if self.up_to_date(stage, key, outputs) {
+            let wall_s = self.stages.stages[stage].wall_s;
+            self.progress.start(stage, 0);
+            let v = load()?;
+            self.progress.finish("up to date, skipped");
+            self.timings.push(StageTiming {
+                stage: stage.into(),
+                wall_s,
+                skipped: true,
+            });
+            return Ok(v);
+        }
+        self.stages.stages.remove(stage);
+        let t0 = Instant::now();
+        let v = work(self.progress)?;
+        let wall_s = t0.elapsed().as_secs_f64();
+        self.stages.stages.insert(
+            stage.into(),
+            StageRecord {
+                key: key.clone(),
+                wall_s,
+            },
+        );
+        save_json(&self.path(), &self.stages)?;
+        self.timings.push(StageTiming {
+            stage: stage.into(),
+            wall_s,
+            skipped: false,
+        });
+        Ok(v)
+    }
+}
+
+fn json<T: Serialize>(v: &T) -> serde_json::Value {
+    serde_json::to_value(v).unwrap_or(serde_json::Value::Null)
+}
+
+/// Runs the demo into `dir` (created if needed). `stop` interrupts the training, which can
+/// then be resumed by running again with the same configuration.
+///
+/// # Errors
+/// Any stage's error, naming the stage's file; [`PipelineError::Interrupted`] when stopped.
+pub fn run_demo(
+    dir: &Path,
+    cfg: &DemoConfig,
+    progress: &dyn Progress,
+    stop: Option<&AtomicBool>,
+) -> Result<DemoSummary> {
+    let t_all = Instant::now();
+    std::fs::create_dir_all(dir).map_err(|source| PipelineError::Io {
+        path: dir.to_path_buf(),
+        source,
+    })?;
+    let stages_path = dir.join("stages.json");
+    let stages: Stages = if stages_path.exists() {
+        load_json(&stages_path)?
+    } else {
+        Stages::default()
+    };
+    let mut run = Runner {
+        dir: dir.to_path_buf(),
+        stages,
+        timings: Vec::new(),
+        progress,
+    };
+
+    // 1. Simulate.
+    let ds_path = dir.join("dataset.npz");
+    let k_sim = serde_json::json!({ "simulation": json(&cfg.simulation), "version": env!("CARGO_PKG_VERSION") });
+    let ds = run.stage(
+        "simulate",
+        &k_sim,
+        &[&ds_path],
+        || load_dataset(&ds_path),
+        |p| {
+            let n = cfg.simulation.trajectories.n_trajectories as u64;
+            p.start("simulate", n);
+            let ds = simulate_dataset(&cfg.simulation, &|| p.advance(1))?;
+            ds.save(&ds_path)
+                .map_err(|source| PipelineError::DatasetFile {
+                    path: ds_path.clone(),
+                    source,
+                })?;
+            p.finish(&format!("{} trajectories", ds.len()));
+            Ok(ds)
+        },
+    )?;
+
+    // 2. LRQSM.
+    let lq_path = dir.join("lrqsm.json");
+    let k_lq = serde_json::json!({ "upstream": k_sim, "features": json(&cfg.lrqsm_features), "options": json(&cfg.lrqsm) });
+    let lrqsm = run.stage(
+        "lrqsm",
+        &k_lq,
+        &[&lq_path],
+        || Ok(LrqsmModel::load(&lq_path)?),
+        |p| {
+            p.start("fit LRQSM", 0);
+            let m = flapssm_qs::lrqsm::fit_dataset(
+                &ds,
+                cfg.lrqsm_features,
+                &cfg.lrqsm,
+                &ds_path.display().to_string(),
+            )?;
+            m.save(&lq_path)?;
+            p.finish("");
+            Ok(m)
+        },
+    )?;
+
+    // 3. PR-SSM.
+    let pm_path = dir.join("prssm.json");
+    let last_path = dir.join("prssm.last.json");
+    let ck_path = dir.join("prssm.ckpt.json");
+    let k_pm = serde_json::json!({ "upstream": k_sim, "training": json(&cfg.training) });
+    let started_key = "prssm (started)";
+    let prssm = {
+        let resume = (!run.up_to_date("prssm", &k_pm, &[&pm_path])
+            && run.stages.stages.get(started_key).is_some_and(|r| r.key == k_pm)
+            && ck_path.exists())
+        .then(|| Checkpoint::load(&ck_path))
+        .transpose()
+        .map_err(|e| PipelineError::Io {
+            path: ck_path.clone(),
+            source: std::io::Error::other(e.to_string()),
+        })?
+        .filter(|ck| ck.config == cfg.training.spec().train);
+        if !run.up_to_date("prssm", &k_pm, &[&pm_path]) {
+            run.stages.stages.insert(
+                started_key.into(),
+                StageRecord {
+                    key: k_pm.clone(),
+                    wall_s: 0.0,
+                },
+            );
+            save_json(&run.path(), &run.stages)?;
+        }
+        run.stage(
+            "prssm",
+            &k_pm,
+            &[&pm_path],
+            || load_model(&pm_path),
+            |p| {
+                let note = match &resume {
+                    Some(ck) => format!("resuming at step {}", ck.state.step),
+                    None => String::new(),
+                };
+                p.start("train PR-SSM", 0);
+                if !note.is_empty() {
+                    p.println(&note);
+                }
+                let out = train_prssm(ds.train(), &cfg.training, Some(&ck_path), resume, p, stop)?;
+                for (m, path) in [(&out.best, &pm_path), (&out.last, &last_path)] {
+                    m.save(path).map_err(|source| PipelineError::ModelFile {
+                        path: path.clone(),
+                        source,
+                    })?;
+                }
+                p.finish(&format!("{} steps", out.outcome.state.step));
+                Ok(out.best)
+            },
+        )?
+    };
+
+    // 4. Evaluate.
+    let eval_dir = dir.join("eval");
+    let metrics_path = eval_dir.join("metrics.json");
+    let report_path = eval_dir.join("report.html");
+    let k_ev = serde_json::json!({ "lrqsm": k_lq, "prssm": k_pm, "evaluation": json(&cfg.evaluation) });
+    let timings_so_far: Vec<(String, String)> = run
+        .timings
+        .iter()
+        .map(|t| {
+            (
+                format!("wall time: {}", t.stage),
+                format!(
+                    "{:.1} s{}",
+                    t.wall_s,
+                    if t.skipped { " (earlier run)" } else { "" }
+                ),
+            )
+        })
+        .collect();
+    let report: EvaluationReport = run.stage(
+        "evaluate",
+        &k_ev,
+        &[&metrics_path, &report_path],
+        || load_json(&metrics_path),
+        |p| {
+            let ctx = ReportContext {
+                title: format!("flapssm demo ({} configuration, seed {})", cfg.name, cfg.seed),
+                intro: "Virtual flapping wing simulated with flapssm; LRQSM (elastic net on quasi-steady features) and PR-SSM trained on the training trajectories and evaluated open loop on all trajectories.".into(),
+                headline: timings_so_far,
+                config: json(cfg),
+            };
+            evaluate(
+                &ds,
+                &ds_path.display().to_string(),
+                &prssm,
+                &lrqsm,
+                &cfg.evaluation,
+                &ctx,
+                &eval_dir,
+                p,
+            )
+        },
+    )?;
+
+    let summary = summarize(cfg, &report, run.timings, t_all.elapsed().as_secs_f64());
+    save_json(&dir.join("summary.json"), &summary)?;
+    Ok(summary)
+}
+
+fn load_dataset(path: &Path) -> Result<Dataset> {
+    Dataset::load(path).map_err(|source| PipelineError::DatasetFile {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
+fn load_model(path: &Path) -> Result<PrssmModel> {
+    PrssmModel::load(path).map_err(|source| PipelineError::ModelFile {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
+fn summarize(
+    cfg: &DemoConfig,
+    r: &EvaluationReport,
+    timings: Vec<StageTiming>,
+    total_wall_s: f64,
+) -> DemoSummary {
+    let (p, l) = match (&r.prssm.test, &r.lrqsm.test) {
+        (Some(a), Some(b)) => (a, b),
+        _ => (&r.prssm.train, &r.lrqsm.train),
+    };
+    let lag = |input: &str| {
+        let v: Vec<f64> = r
+            .authority_findings
+            .iter()
+            .filter(|a| a.input == input)
+            .map(|a| a.median_lag_cycles)
+            .collect();
+        median(&v).unwrap_or(f64::NAN)
+    };
+    DemoSummary {
+        format: SUMMARY_FORMAT.into(),
+        config: cfg.clone(),
+        n_train: r.n_train,
+        n_test: r.n_test,
+        outputs: OUTPUT_NAMES.iter().map(|s| s.to_string()).collect(),
+        prssm_test_rmse: p.rmse_standardized.clone(),
+        lrqsm_test_rmse: l.rmse_standardized.clone(),
+        rmse_ratio: r.rmse_ratio.clone(),
+        ratio_target: RATIO_TARGET,
+        ratio_target_met: r.rmse_ratio.iter().all(|v| *v <= RATIO_TARGET),
+        overall_test_rmse: [p.overall_rmse_standardized, l.overall_rmse_standardized],
+        prssm_cycle_average_ci: r.prssm.cycle_average_error_interval_all.clone(),
+        lrqsm_cycle_average_ci: r.lrqsm.cycle_average_error_interval_all.clone(),
+        authority: r.authority_findings.clone(),
+        aoa_median_lag_cycles: lag("AoA"),
+        a_x_median_lag_cycles: lag("a_x"),
+        timings,
+        total_wall_s,
+        versions: versions(),
+        report: "eval/report.html".into(),
+    }
+}

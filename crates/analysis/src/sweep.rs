@@ -1,0 +1,461 @@
+//! Sweeps of the PR-SSM configuration: one configuration per call ([`sweep_run`], one process
+//! per configuration so any job scheduler can spread them) and the merge of their result files
+//! into one table and figure ([`SweepTable`]).
+//!
+//! Kinds (paper defaults): latent dimension `D_x ∈ {8, 12, 16}`; training-set size (the first
+//! `V` training trajectories, e.g. {64, 128, 256, 512}). Accuracy is the open-loop RMSE of
+//! standardized outputs (the dataset's full training statistics, so all configurations share
+//! one scale) from `start_sample` on, on the trajectories trained on and on the test set.
+
+use std::path::Path;
+use std::sync::atomic::AtomicBool;
+use std::time::Instant;
+
+use flapssm_data::{Dataset, OUTPUT_NAMES};
+use flapssm_prssm::train::EpochRecord;
+use flapssm_prssm::train::fit::FitSpec;
+use plotters::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use crate::metrics::PooledErrors;
+use crate::pipeline::{
+    PipelineError, Progress, Result, TrainingOptions, predict_prssm, save_json, train_prssm,
+};
+use crate::plots::{PALETTE, bold, font, padded_range, render};
+use crate::stats::Rows;
+
+/// Format tag of a sweep result file.
+pub const RESULT_FORMAT: &str = "flapssm-sweep-result";
+/// Version of the sweep result file.
+pub const RESULT_VERSION: u32 = 1;
+
+/// What a sweep varies.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum SweepKind {
+    /// Latent dimension D_x.
+    Dx,
+    /// Number of training trajectories (the first V of the training set).
+    DataSize,
+}
+
+impl SweepKind {
+    /// The command-line name (`dx`, `data-size`).
+    pub fn name(self) -> &'static str {
+        match self {
+            SweepKind::Dx => "dx",
+            SweepKind::DataSize => "data-size",
+        }
+    }
+
+    /// The paper's values: D_x {8, 12, 16}; training sizes {64, 128, 256, 512}.
+    pub fn paper_values(self) -> &'static [usize] {
+        match self {
+            SweepKind::Dx => &[8, 12, 16],
+            SweepKind::DataSize => &[64, 128, 256, 512],
+        }
+    }
+}
+
+impl std::str::FromStr for SweepKind {
+    type Err = String;
+    fn from_str(s: &str) -> std::result::Result<Self, String> {
+        match s {
+            "dx" => Ok(SweepKind::Dx),
+            "data-size" => Ok(SweepKind::DataSize),
+            _ => Err(format!("unknown sweep kind {s:?} (expected dx or data-size)")),
+        }
+    }
+}
+
+/// Standardized RMSE of one set.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SetRmse {
+    /// Trajectories.
+    pub n_trajectories: usize,
+    /// RMSE per output [F_x, F_y, M_x, M_y, M_z] (σ units).
+    pub rmse_standardized: Vec<f64>,
+    /// `√mean(e²)` over all outputs (σ units).
+    pub overall: f64,
+}
+
+/// The result of one sweep configuration (one JSON file).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SweepResult {
+    /// [`RESULT_FORMAT`].
+    pub format: String,
+    /// [`RESULT_VERSION`].
+    pub version: u32,
+    /// What was varied.
+    pub kind: SweepKind,
+    /// Its value.
+    pub value: usize,
+    /// Dataset description.
+    pub dataset: String,
+    /// Trajectories fitted (after the validation hold-out).
+    pub n_fit: usize,
+    /// Validation trajectories (best-model selection).
+    pub n_val: usize,
+    /// The training options as given.
+    pub options: TrainingOptions,
+    /// The resulting fit specification.
+    pub spec: FitSpec,
+    /// Accuracy on the trajectories used for training (fit + validation).
+    pub train: SetRmse,
+    /// Accuracy on the test set (absent without test trajectories).
+    pub test: Option<SetRmse>,
+    /// Best epoch (by validation RMSE).
+    pub best_epoch: Option<u64>,
+    /// Optimizer steps.
+    pub steps: u64,
+    /// Training wall time (s).
+    pub train_wall_s: f64,
+    /// Per-epoch history.
+    pub history: Vec<EpochRecord>,
+}
+
+/// Trains and evaluates one configuration: `kind = value` on top of `opts`. Predictions use
+/// `particles` particles and `seed`; errors count from `start_sample` on.
+///
+/// # Errors
+/// [`PipelineError::Mismatch`] for a value that does not fit the dataset (data-size larger than
+/// the training set or below 2), training and prediction errors.
+#[allow(clippy::too_many_arguments)]
+pub fn sweep_run(
+    ds: &Dataset,
+    dataset_label: &str,
+    kind: SweepKind,
+    value: usize,
+    opts: &TrainingOptions,
+    particles: usize,
+    seed: u64,
+    start_sample: usize,
+    progress: &dyn Progress,
+    stop: Option<&AtomicBool>,
+) -> Result<SweepResult> {
+    ds.validate()?;
+    let stats = ds.standardization()?;
+    let n_train = ds.n_train.min(ds.len());
+    let mut opts = opts.clone();
+    let used = match kind {
+        SweepKind::Dx => {
+            opts.dx = Some(value);
+            n_train
+        }
+        SweepKind::DataSize => {
+            if value < 2 || value > n_train {
+                return Err(PipelineError::Mismatch {
+                    what: "data-size value".into(),
+                    expected: format!("2 ..= {n_train} (the training trajectories)"),
+                    found: value.to_string(),
+                });
+            }
+            value
+        }
+    };
+    let train = &ds.trajectories[..used];
+    let (fit_set, val_set) = opts.split(train)?;
+    let (n_fit, n_val) = (fit_set.len(), val_set.len());
+    progress.start(&format!("train {} = {value}", kind.name()), 0);
+    let t0 = Instant::now();
+    let out = train_prssm(train, &opts, None, None, progress, stop)?;
+    let train_wall_s = t0.elapsed().as_secs_f64();
+    progress.finish("");
+
+    progress.start("predict", ds.len() as u64);
+    let sub = Dataset {
+        trajectories: ds.trajectories[..used]
+            .iter()
+            .chain(&ds.trajectories[n_train..])
+            .cloned()
+            .collect(),
+        n_train: used,
+        ..ds.clone()
+    };
+    let pred = predict_prssm(&out.best, &sub, particles, seed, progress)?;
+    progress.finish("");
+    let z = |y: &[f64]| -> Vec<f64> {
+        y.chunks_exact(5)
+            .flat_map(|r| (0..5).map(move |j| (r[j] - stats.mean_y[j]) / stats.std_y[j]))
+            .collect()
+    };
+    let meas: Vec<Vec<f64>> = sub
+        .trajectories
+        .iter()
+        .map(|t| z(t.outputs.as_deref().unwrap_or_default().as_flattened()))
+        .collect();
+    let predz: Vec<Vec<f64>> = pred.iter().map(|p| z(&p.mean)).collect();
+    let set = |r: std::ops::Range<usize>| -> Result<Option<SetRmse>> {
+        if r.is_empty() {
+            return Ok(None);
+        }
+        fn rows(v: &[Vec<f64>]) -> Result<Vec<Rows<'_>>> {
+            v.iter()
+                .map(|x| Rows::new(x, 5))
+                .collect::<std::result::Result<_, _>>()
+                .map_err(|source| PipelineError::Analysis {
+                    what: "sweep errors".into(),
+                    source,
+                })
+        }
+        let e = PooledErrors::new(
+            &rows(&meas[r.clone()])?,
+            &rows(&predz[r.clone()])?,
+            start_sample,
+        ).map_err(
+            |source| PipelineError::Analysis {
+                what: "sweep errors".into(),
+                source,
+            },
+        )?;
+        Ok(Some(SetRmse {
+            n_trajectories: r.len(),
+            rmse_standardized: e.rmse(),
+            overall: e.overall_rmse(),
+        }))
+    };
+    let train_rmse = set(0..used)?.ok_or_else(|| PipelineError::Mismatch {
+        what: "training trajectories".into(),
+        expected: "at least one".into(),
+        found: "none".into(),
+    })?;
+    Ok(SweepResult {
+        format: RESULT_FORMAT.into(),
+        version: RESULT_VERSION,
+        kind,
+        value,
+        dataset: dataset_label.into(),
+        n_fit,
+        n_val,
+        spec: opts.spec(),
+        options: opts,
+        train: train_rmse,
+        test: set(used..sub.len())?,
+        best_epoch: out.outcome.state.best.as_ref().map(|b| b.epoch),
+        steps: out.outcome.state.step,
+        train_wall_s,
+        history: out.outcome.state.history.clone(),
+    })
+}
+
+/// Reads a sweep result file, checking its format tag and version.
+///
+/// # Errors
+/// [`PipelineError::Io`] / [`PipelineError::Json`] naming the file, [`PipelineError::Mismatch`]
+/// for another format or version.
+pub fn load_result(path: &Path) -> Result<SweepResult> {
+    let v: serde_json::Value = crate::pipeline::load_json(path)?;
+    let format = v.get("format").and_then(|f| f.as_str()).unwrap_or("");
+    let version = v.get("version").and_then(|f| f.as_u64()).unwrap_or(0);
+    if format != RESULT_FORMAT || version != u64::from(RESULT_VERSION) {
+        return Err(PipelineError::Mismatch {
+            what: format!("{}: format/version", path.display()),
+            expected: format!("{RESULT_FORMAT} version {RESULT_VERSION}"),
+            found: format!("{format:?} version {version}"),
+        });
+    }
+    serde_json::from_value(v).map_err(|source| PipelineError::Json {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
+/// One row of the merged table.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SweepRow {
+    /// What was varied.
+    pub kind: SweepKind,
+    /// Its value.
+    pub value: usize,
+    /// Seed of the run.
+    pub seed: u64,
+    /// Trajectories fitted + validation.
+    pub n_train: usize,
+    /// Overall training RMSE (σ units).
+    pub train_overall: f64,
+    /// Overall test RMSE (σ units), if any.
+    pub test_overall: Option<f64>,
+    /// Test RMSE per output, if any.
+    pub test_rmse: Option<Vec<f64>>,
+    /// Training wall time (s).
+    pub train_wall_s: f64,
+    /// The source file.
+    pub source: String,
+}
+
+/// Merged sweep results, sorted by kind, value and seed.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SweepTable {
+    /// Rows.
+    pub rows: Vec<SweepRow>,
+}
+
+impl SweepTable {
+    /// Builds the table from `(source name, result)` pairs.
+    ///
+    /// # Errors
+    /// [`PipelineError::Mismatch`] for no results.
+    pub fn new(results: &[(String, SweepResult)]) -> Result<Self> {
+        if results.is_empty() {
+            return Err(PipelineError::Mismatch {
+                what: "sweep results".into(),
+                expected: "at least one result file".into(),
+                found: "none".into(),
+            });
+        }
+        let mut rows: Vec<SweepRow> = results
+            .iter()
+            .map(|(src, r)| SweepRow {
+                kind: r.kind,
+                value: r.value,
+                seed: r.options.seed,
+                n_train: r.n_fit + r.n_val,
+                train_overall: r.train.overall,
+                test_overall: r.test.as_ref().map(|t| t.overall),
+                test_rmse: r.test.as_ref().map(|t| t.rmse_standardized.clone()),
+                train_wall_s: r.train_wall_s,
+                source: src.clone(),
+            })
+            .collect();
+        rows.sort_by(|a, b| (a.kind, a.value, a.seed).cmp(&(b.kind, b.value, b.seed)));
+        Ok(Self { rows })
+    }
+
+    /// CSV text: one row per configuration.
+    pub fn to_csv(&self) -> String {
+        let mut s = String::from("kind,value,seed,n_train,train_overall_rmse,test_overall_rmse");
+        for n in OUTPUT_NAMES {
+            s.push_str(&format!(",test_rmse_{n}"));
+        }
+        s.push_str(",train_wall_s,source\n");
+        let opt = |v: Option<f64>| v.map_or(String::new(), |v| v.to_string());
+        for r in &self.rows {
+            s.push_str(&format!(
+                "{},{},{},{},{},{}",
+                r.kind.name(),
+                r.value,
+                r.seed,
+                r.n_train,
+                r.train_overall,
+                opt(r.test_overall)
+            ));
+            for j in 0..5 {
+                s.push_str(&format!(
+                    ",{}",
+                    opt(r.test_rmse.as_ref().and_then(|v| v.get(j).copied()))
+                ));
+            }
+            s.push_str(&format!(",{},{}\n", r.train_wall_s, r.source.replace(',', ";")));
+        }
+        s
+    }
+
+    /// Writes `table` (CSV), `table` with extension `.json`, and the figure (`.png`), atomically.
+    ///
+    /// # Errors
+    /// I/O and figure errors naming the file.
+    pub fn write(&self, table: &Path) -> Result<()> {
+        flapssm_data::atomic::write_bytes_atomic(table, self.to_csv().as_bytes()).map_err(
+            |source| PipelineError::Io {
+                path: table.to_path_buf(),
+                source,
+            },
+        )?;
+        save_json(&table.with_extension("json"), self)?;
+        let fig = table.with_extension("png");
+        self.figure(&fig)
+            .map_err(|source| PipelineError::Analysis {
+                what: "sweep figure".into(),
+                source,
+            })
+    }
+
+    /// Overall training and test RMSE vs the swept value, one panel per kind (mean over seeds
+    /// as a line, each run as a dot).
+    ///
+    /// # Errors
+    /// Plot and I/O errors.
+    pub fn figure(&self, path: &Path) -> crate::Result<()> {
+        let mut kinds: Vec<SweepKind> = self.rows.iter().map(|r| r.kind).collect();
+        kinds.dedup();
+        render!(path, (560 * kinds.len() as u32, 440), |root| {
+            let areas = root.split_evenly((1, kinds.len()));
+            for (area, kind) in areas.iter().zip(&kinds) {
+                let rows: Vec<&SweepRow> = self.rows.iter().filter(|r| r.kind == *kind).collect();
+                let xs = rows.iter().map(|r| r.value as f64).collect::<Vec<_>>();
+                let ys = rows
+                    .iter()
+                    .flat_map(|r| std::iter::once(r.train_overall).chain(r.test_overall))
+                    .collect::<Vec<_>>();
+                let (x0, x1) = padded_range(xs.iter(), 0.08);
+                let (_, y1) = padded_range(ys.iter(), 0.1);
+                let mut ch = ChartBuilder::on(area)
+                    .caption(
+                        match kind {
+                            SweepKind::Dx => "accuracy vs latent dimension D_x",
+                            SweepKind::DataSize => "accuracy vs training trajectories",
+                        },
+                        bold(18.0),
+                    )
+                    .margin(12)
+                    .x_label_area_size(40)
+                    .y_label_area_size(60)
+                    .build_cartesian_2d(x0..x1, 0.0..y1)?;
+                ch.configure_mesh()
+                    .x_desc(match kind {
+                        SweepKind::Dx => "D_x",
+                        SweepKind::DataSize => "training trajectories",
+                    })
+                    .y_desc("overall RMSE (σ units)")
+                    .label_style(font(14.0))
+                    .light_line_style(RGBColor(235, 235, 235))
+                    .draw()?;
+                let mut values: Vec<usize> = rows.iter().map(|r| r.value).collect();
+                values.dedup();
+                for (c, (label, get)) in [
+                    ("training", (|r: &SweepRow| Some(r.train_overall)) as fn(&SweepRow) -> Option<f64>),
+                    ("test", |r: &SweepRow| r.test_overall),
+                ]
+                .into_iter()
+                .enumerate()
+                {
+                    let col = PALETTE[c];
+                    let pts: Vec<(f64, f64)> = rows
+                        .iter()
+                        .filter_map(|r| get(r).map(|v| (r.value as f64, v)))
+                        .collect();
+                    if pts.is_empty() {
+                        continue;
+                    }
+                    let means: Vec<(f64, f64)> = values
+                        .iter()
+                        .filter_map(|&v| {
+                            let s: Vec<f64> = rows
+                                .iter()
+                                .filter(|r| r.value == v)
+                                .filter_map(|r| get(r))
+                                .collect();
+                            (!s.is_empty())
+                                .then(|| (v as f64, s.iter().sum::<f64>() / s.len() as f64))
+                        })
+                        .collect();
+                    ch.draw_series(LineSeries::new(means, col.stroke_width(2)))?
+                        .label(label)
+                        .legend(move |(x, y)| {
+                            PathElement::new(vec![(x, y), (x + 22, y)], col.stroke_width(3))
+                        });
+                    ch.draw_series(
+                        pts.iter()
+                            .map(|&(x, y)| Circle::new((x, y), 4, col.filled())),
+                    )?;
+                }
+                ch.configure_series_labels()
+                    .label_font(font(14.0))
+                    .background_style(WHITE.mix(0.85))
+                    .border_style(RGBColor(180, 180, 180))
+                    .draw()?;
+            }
+            Ok::<(), Box<dyn std::error::Error>>(())
+        })
+    }
+}

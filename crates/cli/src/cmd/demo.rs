@@ -1,0 +1,182 @@
+//! `flapssm demo`: simulate, fit the LRQSM, train the PR-SSM, evaluate and report, resumably.
+
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex};
+
+use anyhow::Context;
+use clap::Args;
+use flapssm_analysis::demo::{DemoConfig, run_demo};
+use flapssm_analysis::pipeline::Progress;
+use indicatif::{ProgressBar, ProgressStyle};
+
+/// Run the whole pipeline on a simulated wing.
+#[derive(Args)]
+pub struct DemoArgs {
+    /// Output folder (stages already there with the same configuration are skipped).
+    #[arg(long, default_value = "flapssm-demo")]
+    out: PathBuf,
+    /// The paper's configuration (548 trajectories, D_x 12, M 100, 30 particles, 1000 epochs;
+    /// hours) instead of the default 15-minute one.
+    #[arg(long)]
+    full: bool,
+    /// Master seed (simulation, training, prediction).
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// Override the number of trajectories (train/test split scaled as published).
+    #[arg(long)]
+    trajectories: Option<usize>,
+    /// Override the number of training epochs.
+    #[arg(long)]
+    epochs: Option<u64>,
+}
+
+/// Progress bars: one per stage, lines printed above.
+pub struct Bars {
+    bar: Mutex<Option<ProgressBar>>,
+}
+
+impl Bars {
+    /// No stage running yet.
+    pub fn new() -> Self {
+        Self {
+            bar: Mutex::new(None),
+        }
+    }
+
+    fn with(&self, f: impl FnOnce(&ProgressBar)) {
+        if let Ok(g) = self.bar.lock()
+            && let Some(b) = g.as_ref()
+        {
+            f(b);
+        }
+    }
+}
+
+impl Progress for Bars {
+    fn start(&self, stage: &str, total: u64) {
+        let style = if total > 0 {
+            ProgressStyle::with_template(
+                "{prefix:>16} [{bar:30}] {pos}/{len} {elapsed_precise} (eta {eta}) {msg}",
+            )
+        } else {
+            ProgressStyle::with_template("{prefix:>16} {spinner} {elapsed_precise} {msg}")
+        };
+        let bar = ProgressBar::new(total);
+        if let Ok(s) = style {
+            bar.set_style(s.progress_chars("=> "));
+        }
+        bar.set_prefix(stage.to_string());
+        bar.enable_steady_tick(std::time::Duration::from_millis(200));
+        if let Ok(mut g) = self.bar.lock() {
+            if let Some(old) = g.take() {
+                old.finish();
+            }
+            *g = Some(bar);
+        }
+    }
+    fn advance(&self, n: u64) {
+        self.with(|b| b.inc(n));
+    }
+    fn set(&self, pos: u64, total: u64) {
+        self.with(|b| {
+            if b.length() != Some(total) {
+                b.set_length(total);
+                if let Ok(s) = ProgressStyle::with_template(
+                    "{prefix:>16} [{bar:30}] {pos}/{len} {elapsed_precise} (eta {eta}) {msg}",
+                ) {
+                    b.set_style(s.progress_chars("=> "));
+                }
+            }
+            b.set_position(pos);
+        });
+    }
+    fn message(&self, msg: &str) {
+        self.with(|b| b.set_message(msg.to_string()));
+    }
+    fn println(&self, line: &str) {
+        let mut printed = false;
+        self.with(|b| {
+            b.println(line);
+            printed = true;
+        });
+        if !printed {
+            eprintln!("{line}");
+        }
+    }
+    fn finish(&self, note: &str) {
+        if let Ok(mut g) = self.bar.lock()
+            && let Some(b) = g.take()
+        {
+            b.finish_with_message(note.to_string());
+        }
+    }
+}
+
+/// A stop flag set by Ctrl-C.
+pub fn stop_flag() -> anyhow::Result<Arc<AtomicBool>> {
+    let stop = Arc::new(AtomicBool::new(false));
+    let s = Arc::clone(&stop);
+    ctrlc::set_handler(move || s.store(true, Ordering::SeqCst))
+        .context("installing the Ctrl-C handler")?;
+    Ok(stop)
+}
+
+/// Runs `flapssm demo`.
+pub fn run(args: DemoArgs) -> anyhow::Result<()> {
+    let mut cfg = if args.full {
+        DemoConfig::full(args.seed)
+    } else {
+        DemoConfig::default_for(args.seed)
+    };
+    if let Some(n) = args.trajectories {
+        let t = &mut cfg.simulation.trajectories;
+        t.n_trajectories = n;
+        t.n_train = flapssm_wing::trajectories::default_n_train(n);
+    }
+    if let Some(e) = args.epochs {
+        cfg.training.epochs = Some(e);
+    }
+    let stop = stop_flag()?;
+    let bars = Bars::new();
+    let s = run_demo(&args.out, &cfg, &bars, Some(&stop))
+        .with_context(|| format!("demo in {}", args.out.display()))?;
+    let f = |v: &[f64]| {
+        v.iter()
+            .map(|x| format!("{x:.3}"))
+            .collect::<Vec<_>>()
+            .join(" ")
+    };
+    println!(
+        "{} configuration, {} train / {} test trajectories",
+        s.config.name, s.n_train, s.n_test
+    );
+    println!("outputs               {}", s.outputs.join(" "));
+    println!("PR-SSM test RMSE (σ)  {}", f(&s.prssm_test_rmse));
+    println!("LRQSM  test RMSE (σ)  {}", f(&s.lrqsm_test_rmse));
+    println!(
+        "ratio PR-SSM/LRQSM    {}  (target ≤ {}: {})",
+        f(&s.rmse_ratio),
+        s.ratio_target,
+        if s.ratio_target_met { "met" } else { "NOT met" }
+    );
+    println!(
+        "median lag of AoA / a_x on the output states: {:.3} / {:.3} cycles",
+        s.aoa_median_lag_cycles, s.a_x_median_lag_cycles
+    );
+    for t in &s.timings {
+        println!(
+            "  {:<10} {:>8.1} s{}",
+            t.stage,
+            t.wall_s,
+            if t.skipped { " (skipped, earlier run)" } else { "" }
+        );
+    }
+    println!("total {:.1} s", s.total_wall_s);
+    println!(
+        "report {}; summary {}",
+        args.out.join(&s.report).display(),
+        args.out.join("summary.json").display()
+    );
+    Ok(())
+}
