@@ -16,12 +16,16 @@ fn flapssm(args: &[&str]) -> Output {
 }
 
 fn reference() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/reference/elastic-net/reference.npz")
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../../shared/reference/elastic-net/reference.npz")
 }
 
 fn max_abs_diff(a: &[f64], b: &[f64]) -> f64 {
     assert_eq!(a.len(), b.len());
-    a.iter().zip(b).map(|(u, v)| (u - v).abs()).fold(0.0, f64::max)
+    a.iter()
+        .zip(b)
+        .map(|(u, v)| (u - v).abs())
+        .fold(0.0, f64::max)
 }
 
 fn floats(v: &serde_json::Value) -> Vec<f64> {
@@ -34,7 +38,11 @@ fn floats(v: &serde_json::Value) -> Vec<f64> {
 fn write_csv(path: &Path, header: &[String], rows: impl Iterator<Item = Vec<f64>>) {
     let mut s = header.join(",") + "\n";
     for r in rows {
-        s += &r.iter().map(|v| v.to_string()).collect::<Vec<_>>().join(",");
+        s += &r
+            .iter()
+            .map(|v| v.to_string())
+            .collect::<Vec<_>>()
+            .join(",");
         s.push('\n');
     }
     std::fs::write(path, s).unwrap();
@@ -60,11 +68,29 @@ fn fit_csv_matches_scikit_learn_reference() {
     );
     let model = dir.path().join("m.json");
     let out = flapssm(&[
-        "qs", "fit-csv", csv.to_str().unwrap(), "--targets", "y", "--out",
-        model.to_str().unwrap(), "--no-standardize", "--no-intercept", "--contiguous",
-        "--folds", "10", "--alpha", "0.75", "--tol", "1e-13", "--json",
+        "qs",
+        "fit-csv",
+        csv.to_str().unwrap(),
+        "--targets",
+        "y",
+        "--out",
+        model.to_str().unwrap(),
+        "--no-standardize",
+        "--no-intercept",
+        "--contiguous",
+        "--folds",
+        "10",
+        "--alpha",
+        "0.75",
+        "--tol",
+        "1e-13",
+        "--json",
     ]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     let t = &v["fit"]["targets"][0];
     let mut check = |key: &str, json: &serde_json::Value| {
@@ -76,22 +102,30 @@ fn fit_csv_matches_scikit_learn_reference() {
     check("cv_mse_mean", &t["cv_mse_mean"]);
     check("cv_mse_se", &t["cv_mse_se"]);
     check("coef_1se", &v["chosen"][0]["coef"]);
-    assert_eq!(t["index_min"].as_u64(), Some(r.scalar("index_min").unwrap() as u64));
-    assert_eq!(t["index_1se"].as_u64(), Some(r.scalar("index_1se").unwrap() as u64));
+    assert_eq!(
+        t["index_min"].as_u64(),
+        Some(r.scalar("index_min").unwrap() as u64)
+    );
+    assert_eq!(
+        t["index_1se"].as_u64(),
+        Some(r.scalar("index_1se").unwrap() as u64)
+    );
     // The file written is the same model.
-    let file: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&model).unwrap()).unwrap();
+    let file: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&model).unwrap()).unwrap();
     assert_eq!(file, v);
 }
 
 /// Smooth deterministic inputs; outputs linear in the published features plus pseudo-noise
 /// uniform in ±`noise` (std noise/√3).
 fn dataset(n_traj: usize, n_t: usize, noise: f64) -> Dataset {
-    let beta: [[f64; 11]; 5] = std::array::from_fn(|o| {
-        std::array::from_fn(|j| ((o * 11 + j) as f64 * 0.7).sin() * 0.1)
-    });
+    let beta: [[f64; 11]; 5] =
+        std::array::from_fn(|o| std::array::from_fn(|j| ((o * 11 + j) as f64 * 0.7).sin() * 0.1));
     let mut state = 12345u64;
     let mut uniform = move || {
-        state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
         (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
     };
     let trajectories = (0..n_traj)
@@ -146,33 +180,67 @@ fn fit_and_predict_a_dataset() {
     dataset(24, 200, noise).save(&ds_path).unwrap();
     let model = dir.path().join("lrqsm.json");
     let out = flapssm(&[
-        "qs", "fit", ds_path.to_str().unwrap(), "--out", model.to_str().unwrap(), "--rule", "min",
+        "qs",
+        "fit",
+        ds_path.to_str().unwrap(),
+        "--out",
+        model.to_str().unwrap(),
+        "--rule",
+        "min",
     ]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let text = String::from_utf8_lossy(&out.stdout);
-    assert!(text.contains("index_1se") && text.contains("alphadot_vy"), "{text}");
+    assert!(
+        text.contains("index_1se") && text.contains("alphadot_vy"),
+        "{text}"
+    );
 
     let pred = dir.path().join("pred.npz");
     let out = flapssm(&[
-        "qs", "predict", model.to_str().unwrap(), ds_path.to_str().unwrap(), "--out",
+        "qs",
+        "predict",
+        model.to_str().unwrap(),
+        ds_path.to_str().unwrap(),
+        "--out",
         pred.to_str().unwrap(),
     ]);
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     assert!(String::from_utf8_lossy(&out.stdout).contains("test RMSE"));
     let mut r = NpzReader::open(&pred).unwrap();
     let y = r.f64_shaped("y_pred", &[24, 200, 5]).unwrap();
-    assert_eq!(r.f64_shaped("y_pred_standardized", &[24, 200, 5]).unwrap().len(), y.len());
+    assert_eq!(
+        r.f64_shaped("y_pred_standardized", &[24, 200, 5])
+            .unwrap()
+            .len(),
+        y.len()
+    );
     // The model is linear in these features, so the test error is the noise level.
     let noise_std = noise / 3f64.sqrt();
     for v in r.f64_shaped("rmse_test", &[5]).unwrap() {
-        assert!((v / noise_std - 1.0).abs() < 0.15, "test RMSE {v} vs noise {noise_std}");
+        assert!(
+            (v / noise_std - 1.0).abs() < 0.15,
+            "test RMSE {v} vs noise {noise_std}"
+        );
     }
 
     // Published mode drops the intercept: the outputs' offsets are then missing.
     let pred2 = dir.path().join("pred2.npz");
     let out = flapssm(&[
-        "qs", "predict", model.to_str().unwrap(), ds_path.to_str().unwrap(), "--out",
-        pred2.to_str().unwrap(), "--published",
+        "qs",
+        "predict",
+        model.to_str().unwrap(),
+        ds_path.to_str().unwrap(),
+        "--out",
+        pred2.to_str().unwrap(),
+        "--published",
     ]);
     assert!(out.status.success());
     let mut r2 = NpzReader::open(&pred2).unwrap();
@@ -198,19 +266,48 @@ fn bad_input_is_reported() {
     let m = model.to_str().unwrap();
     let c = csv.to_str().unwrap();
 
-    write_csv(&csv, &header, rows(|i| vec![i as f64, (i * i % 7) as f64, 2.0, i as f64 * 0.5 + 1.0]));
-    fails_with(&["qs", "fit-csv", c, "--targets", "y", "--out", m], &["'c'", "constant"]);
-    fails_with(&["qs", "fit-csv", c, "--targets", "z", "--out", m], &["'z'", "a, b, c, y"]);
+    write_csv(
+        &csv,
+        &header,
+        rows(|i| vec![i as f64, (i * i % 7) as f64, 2.0, i as f64 * 0.5 + 1.0]),
+    );
     fails_with(
-        &["qs", "fit-csv", c, "--targets", "y", "--features", "a,b", "--folds", "40", "--out", m],
+        &["qs", "fit-csv", c, "--targets", "y", "--out", m],
+        &["'c'", "constant"],
+    );
+    fails_with(
+        &["qs", "fit-csv", c, "--targets", "z", "--out", m],
+        &["'z'", "a, b, c, y"],
+    );
+    fails_with(
+        &[
+            "qs",
+            "fit-csv",
+            c,
+            "--targets",
+            "y",
+            "--features",
+            "a,b",
+            "--folds",
+            "40",
+            "--out",
+            m,
+        ],
         &["30 rows", "40"],
     );
     let mut text = std::fs::read_to_string(&csv).unwrap();
     text = text.replacen("\n3,", "\nnan,", 1);
     std::fs::write(&csv, text).unwrap();
-    fails_with(&["qs", "fit-csv", c, "--targets", "y", "--out", m], &["'a'", "nan", "line 5"]);
+    fails_with(
+        &["qs", "fit-csv", c, "--targets", "y", "--out", m],
+        &["'a'", "nan", "line 5"],
+    );
     assert!(!model.exists(), "no model written on error");
 
-    std::fs::write(&model, "{\"kind\": \"flapssm-lrqsm\", \"format_version\": 99}").unwrap();
+    std::fs::write(
+        &model,
+        "{\"kind\": \"flapssm-lrqsm\", \"format_version\": 99}",
+    )
+    .unwrap();
     fails_with(&["qs", "predict", m, c, "--out", "p.npz"], &["version 99"]);
 }

@@ -31,6 +31,42 @@ pub(crate) fn gemm(
     matmul(dst, accum, lhs, rhs, alpha, Par::Seq);
 }
 
+/// `Σ aᵢbᵢ` in eight interleaved partial sums (vectorizes; fixed order, so deterministic).
+#[inline]
+pub(crate) fn dot(a: &[f64], b: &[f64]) -> f64 {
+    let mut acc = [0.0; 8];
+    let (ac, bc) = (a.chunks_exact(8), b.chunks_exact(8));
+    let (ar, br) = (ac.remainder(), bc.remainder());
+    for (x, y) in ac.zip(bc) {
+        for l in 0..8 {
+            acc[l] = x[l].mul_add(y[l], acc[l]);
+        }
+    }
+    let mut s = ((acc[0] + acc[4]) + (acc[1] + acc[5])) + ((acc[2] + acc[6]) + (acc[3] + acc[7]));
+    for (x, y) in ar.iter().zip(br) {
+        s = x.mul_add(*y, s);
+    }
+    s
+}
+
+/// `Σ aᵢ` in eight interleaved partial sums (vectorizes; fixed order).
+#[inline]
+pub(crate) fn sum(a: &[f64]) -> f64 {
+    let mut acc = [0.0; 8];
+    let ac = a.chunks_exact(8);
+    let ar = ac.remainder();
+    for x in ac {
+        for l in 0..8 {
+            acc[l] += x[l];
+        }
+    }
+    let mut s = ((acc[0] + acc[4]) + (acc[1] + acc[5])) + ((acc[2] + acc[6]) + (acc[3] + acc[7]));
+    for x in ar {
+        s += x;
+    }
+    s
+}
+
 /// `B ← L⁻¹ B` for the lower-triangular `L` (`M × M`) and `B` (`M × N`).
 #[inline]
 pub(crate) fn solve_lower(l: &[f64], m: usize, b: &mut [f64], n: usize) {

@@ -433,3 +433,25 @@ fn hovering_sanity() {
         assert!(band.contains(&cn_mid), "{fidelity:?}: mid-stroke C_N = {cn_mid}");
     }
 }
+
+/// The default strip count (8) is converged for L1 on a generated trajectory: every channel
+/// within 0.2 % of its peak of the 40-strip result.
+#[test]
+fn default_strip_count_is_converged() {
+    let dt = 0.004;
+    let states = generated_states(dt, 3000);
+    let run = |n_strips| {
+        let cfg = VirtualWingConfig { fidelity: Fidelity::L1, n_strips, ..VirtualWingConfig::default() };
+        let mut w = VirtualWing::new(&cfg).unwrap();
+        let mut y = vec![[0.0; 5]; states.len()];
+        w.aero_loads_into(&states, dt, &mut y);
+        y
+    };
+    assert_eq!(VirtualWingConfig::default().n_strips, 8);
+    let (a, b) = (run(8), run(40));
+    for c in 0..5 {
+        let peak = b.iter().map(|y| y[c].abs()).fold(0.0, f64::max);
+        let err = a.iter().zip(&b).map(|(x, y)| (x[c] - y[c]).abs()).fold(0.0, f64::max);
+        assert!(err <= 2e-3 * peak, "channel {c}: {err} vs peak {peak}");
+    }
+}

@@ -167,8 +167,13 @@ fn fit(a: FitArgs) -> Result<()> {
         Features::Published => FeatureSet::Published,
         Features::PaperText => FeatureSet::PaperText,
     };
-    let model = fit_dataset(&ds, set, &a.path.options(), &a.dataset.display().to_string())
-        .with_context(|| format!("fitting the LRQSM on {}", a.dataset.display()))?;
+    let model = fit_dataset(
+        &ds,
+        set,
+        &a.path.options(),
+        &a.dataset.display().to_string(),
+    )
+    .with_context(|| format!("fitting the LRQSM on {}", a.dataset.display()))?;
     finish(&model, &a.out, a.path.json)
 }
 
@@ -234,11 +239,17 @@ fn finish(model: &LrqsmModel, out: &Path, json: bool) -> Result<()> {
     println!();
     for (j, f) in model.fit.feature_names.iter().enumerate() {
         print!("{f:<22}");
-        model.chosen.iter().for_each(|c| print!(" {:>12.5e}", c.coef[j]));
+        model
+            .chosen
+            .iter()
+            .for_each(|c| print!(" {:>12.5e}", c.coef[j]));
         println!();
     }
     print!("{:<22}", "intercept");
-    model.chosen.iter().for_each(|c| print!(" {:>12.5e}", c.intercept));
+    model
+        .chosen
+        .iter()
+        .for_each(|c| print!(" {:>12.5e}", c.intercept));
     println!();
     println!("wrote {}", out.display());
     Ok(())
@@ -281,7 +292,11 @@ fn predict(a: PredictArgs) -> Result<()> {
         a.out.display(),
         pred.n_trajectories,
         pred.n_samples,
-        if a.published { ", intercept dropped" } else { "" }
+        if a.published {
+            ", intercept dropped"
+        } else {
+            ""
+        }
     );
     Ok(())
 }
