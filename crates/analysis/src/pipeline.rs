@@ -1630,3 +1630,149 @@ pub fn train_prssm(
     }
     Ok(out)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use flapssm_wing::virtual_wing::{SimulationConfig, simulate_dataset};
+
+    fn tiny_dataset() -> Dataset {
+        let mut cfg = SimulationConfig::default();
+        cfg.trajectories.n_trajectories = 6;
+        cfg.trajectories.n_train = 4;
+        cfg.trajectories.seed = 3;
+        simulate_dataset(&cfg, &|| {}).unwrap()
+    }
+
+    #[test]
+    fn validation_split_follows_the_fraction() {
+        let ds = tiny_dataset();
+        let t = &ds.trajectories[..5];
+        let split = |f: f64| {
+            let o = TrainingOptions {
+                val_fraction: f,
+                ..TrainingOptions::default()
+            };
+            o.split(t).map(|(a, b)| (a.len(), b.len()))
+        };
+        assert_eq!(split(0.0).unwrap(), (5, 0));
+        assert_eq!(split(0.2).unwrap(), (4, 1));
+        assert_eq!(split(0.5).unwrap(), (2, 3)); // round(2.5) = 3
+        assert_eq!(split(0.99).unwrap(), (1, 4)); // at least one trajectory is fitted
+        assert!(split(1.0).is_err() && split(-0.1).is_err());
+    }
+
+    #[test]
+    fn overrides_reach_the_fit_spec() {
+        let o = TrainingOptions {
+            dx: Some(6),
+            inducing: Some(9),
+            particles: Some(4),
+            epochs: Some(7),
+            batch: Some(2),
+            lr: Some(0.2),
+            seed: 11,
+            ..TrainingOptions::default()
+        };
+        let s = o.spec();
+        assert_eq!((s.model.n_state, s.model.n_inducing), (6, 9));
+        assert_eq!((s.particles, s.eval_particles), (4, 4));
+        assert_eq!(s.train.budget, Budget::Epochs(7));
+        assert_eq!((s.train.batch_size, s.train.lr, s.train.seed), (2, 0.2, 11));
+        // No override: the paper preset.
+        let p = TrainingOptions::default().spec();
+        assert_eq!(p, {
+            let mut f = FitSpec::preset(Preset::Paper, 7, 5);
+            f.train.checkpoint_every = 10;
+            f
+        });
+    }
+
+    /// The pipeline's LRQSM errors agree with the qs crate's own RMSE (computed there from raw
+    /// loads divided by σ), and its sums are consistent: overall² = mean of per-output RMSE²,
+    /// ratio = PR-SSM / LRQSM, the windows are the published ones.
+    #[test]
+    fn metrics_agree_with_independent_computations() {
+        let ds = tiny_dataset();
+        let lrqsm = flapssm_qs::lrqsm::fit_dataset(
+            &ds,
+            Default::default(),
+            &Default::default(),
+            "tiny",
+        )
+        .unwrap();
+        let q = flapssm_qs::lrqsm::predict_dataset(&lrqsm, &ds, InterceptMode::Fitted).unwrap();
+        let opts = TrainingOptions {
+            dx: Some(5),
+            inducing: Some(6),
+            particles: Some(3),
+            epochs: Some(1),
+            val_fraction: 0.0,
+            ..TrainingOptions::default()
+        };
+        let fit = train_prssm(ds.train(), &opts, None, None, &NoProgress, None).unwrap();
+        let dir = std::env::temp_dir().join(format!("flapssm-pipeline-{}", std::process::id()));
+        let eo = EvalOptions {
+            start_sample: 0,
+            particles: 3,
+            authority: AuthorityConfig {
+                grid_points: 20,
+                ..AuthorityConfig::default()
+            },
+            ..EvalOptions::default()
+        };
+        let r = evaluate(
+            &ds,
+            "tiny",
+            &fit.best,
+            &lrqsm,
+            &eo,
+            &ReportContext::default(),
+            &dir,
+            &NoProgress,
+        )
+        .unwrap();
+        let lt = r.lrqsm.test.as_ref().unwrap();
+        let qt = q.rmse_test.as_ref().unwrap();
+        for j in 0..5 {
+            assert!((lt.rmse_standardized[j] - qt.standardized[j]).abs() < 1e-10);
+            assert!(
+                (r.lrqsm.train.rmse_standardized[j] - q.rmse_train.as_ref().unwrap().standardized[j])
+                    .abs()
+                    < 1e-10
+            );
+        }
+        let pt = r.prssm.test.as_ref().unwrap();
+        let ms: f64 = pt.rmse_standardized.iter().map(|v| v * v).sum::<f64>() / 5.0;
+        assert!((pt.overall_rmse_standardized - ms.sqrt()).abs() < 1e-12);
+        for j in 0..5 {
+            assert_eq!(r.rmse_ratio[j], pt.rmse_standardized[j] / lt.rmse_standardized[j]);
+        }
+        for (t, m) in ds.trajectories.iter().zip(&r.trajectories) {
+            let stroke: Vec<f64> = t.euler_rad.iter().map(|e| e[0]).collect();
+            let w = published_window(&stroke).unwrap();
+            assert_eq!((m.window_start, m.period_samples), (w.first, w.duration));
+        }
+        assert_eq!(r.authority_findings.len(), 10);
+        for f in &r.files {
+            assert!(dir.join(f).exists(), "{f}");
+        }
+        std::fs::remove_dir_all(&dir).ok();
+    }
+
+    #[test]
+    fn model_of_the_wrong_shape_is_rejected() {
+        let ds = tiny_dataset();
+        let mut cfg = flapssm_prssm::ModelConfig::new(4, 2, 3, 5);
+        cfg.n_inducing = 5;
+        let params = flapssm_prssm::Params::init(&cfg, &Default::default(), 1);
+        let m = PrssmModel {
+            config: cfg,
+            params,
+            normalization: None,
+            training: serde_json::Value::Null,
+        };
+        let e = predict_prssm(&m, &ds, 2, 0, &NoProgress).unwrap_err();
+        assert!(e.to_string().contains("7 inputs and 5 outputs"), "{e}");
+    }
+}

@@ -120,7 +120,7 @@ pub struct VirtualWingConfig {
     pub fluid: Fluid,
     /// Sensor origin on the pitch axis, distance from the stroke axis (m; 0.055 = wing root).
     pub sensor_radius_m: f64,
-    /// Blade-element strips (Gauss–Legendre; 8, converged to 0.2 % of peak).
+    /// Blade-element strips (Gauss–Legendre; 8, within 0.5 % of peak of 40 strips).
     pub n_strips: usize,
     /// L0/L1 parameters (L0 uses only `aero.quasi_steady`).
     pub aero: UnsteadyParams,

