@@ -3,12 +3,13 @@
 //! of the fit is scored there. Never looks at the test part.
 //!
 //! `cargo run --release -p flapssm-analysis --example sysid_validate -- FILE IN OUT VARIANT [SEEDS]`
-//! with VARIANT one of `reference`, `linear-recognition`, `lr0.03`, `eval-every-5`.
+//! with VARIANT a comma-separated list of `reference`, `linear-recognition`, `lr=X`,
+//! `cosine=FINAL_FACTOR`.
 
 use std::path::Path;
 
 use flapssm_analysis::sysid::{IoRecord, SysidSpec, run};
-use flapssm_prssm::train::{InitialStateSpec, RecognitionConfig};
+use flapssm_prssm::train::{InitialStateSpec, LrSchedule, RecognitionConfig};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let a: Vec<String> = std::env::args().collect();
@@ -23,17 +24,23 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         seeds: a.get(5).map_or(Ok(2), |s| s.parse())?,
         ..SysidSpec::reference(1, 1)
     };
-    match a[4].as_str() {
-        "reference" => {}
-        "linear-recognition" => {
-            spec.fit.initial_state = InitialStateSpec::Recognition(RecognitionConfig {
-                hidden: 0,
-                ..RecognitionConfig::default()
-            })
+    for token in a[4].split(',') {
+        match token.split_once('=') {
+            None if token == "reference" => {}
+            None if token == "linear-recognition" => {
+                spec.fit.initial_state = InitialStateSpec::Recognition(RecognitionConfig {
+                    hidden: 0,
+                    ..RecognitionConfig::default()
+                })
+            }
+            Some(("lr", v)) => spec.fit.train.lr = v.parse()?,
+            Some(("cosine", v)) => {
+                spec.fit.train.schedule = LrSchedule::Cosine {
+                    final_factor: v.parse()?,
+                }
+            }
+            _ => return Err(format!("unknown variant {token}").into()),
         }
-        "lr0.03" => spec.fit.train.lr = 0.03,
-        "eval-every-5" => spec.fit.train.eval_every = 5,
-        v => return Err(format!("unknown variant {v}").into()),
     }
     let (report, _) = run(&train_part, &spec, true, |r| {
         eprintln!(

@@ -23,7 +23,7 @@ use std::time::Instant;
 
 use flapssm_data::{Dataset, OUTPUT_NAMES};
 use flapssm_prssm::PrssmModel;
-use flapssm_prssm::train::Checkpoint;
+use flapssm_prssm::train::{Checkpoint, LrSchedule};
 use flapssm_qs::{EnetOptions, LrqsmModel};
 use flapssm_wing::features::FeatureSet;
 use flapssm_wing::virtual_wing::{SimulationConfig, simulate_dataset};
@@ -78,9 +78,10 @@ impl DemoConfig {
                 dx: Some(8),
                 inducing: Some(32),
                 particles: Some(10),
-                epochs: Some(600),
+                epochs: Some(1200),
                 batch: Some(4),
                 lr: Some(0.05),
+                schedule: Some(LrSchedule::Exponential { final_factor: 0.1 }),
                 eval_every: Some(25),
                 seed,
                 ..TrainingOptions::default()
@@ -327,7 +328,11 @@ pub fn run_demo(
     let started_key = "prssm (started)";
     let prssm = {
         let resume = (!run.up_to_date("prssm", &k_pm, &[&pm_path])
-            && run.stages.stages.get(started_key).is_some_and(|r| r.key == k_pm)
+            && run
+                .stages
+                .stages
+                .get(started_key)
+                .is_some_and(|r| r.key == k_pm)
             && ck_path.exists())
         .then(|| Checkpoint::load(&ck_path))
         .transpose()
@@ -377,7 +382,8 @@ pub fn run_demo(
     let eval_dir = dir.join("eval");
     let metrics_path = eval_dir.join("metrics.json");
     let report_path = eval_dir.join("report.html");
-    let k_ev = serde_json::json!({ "lrqsm": k_lq, "prssm": k_pm, "evaluation": json(&cfg.evaluation) });
+    let k_ev =
+        serde_json::json!({ "lrqsm": k_lq, "prssm": k_pm, "evaluation": json(&cfg.evaluation) });
     let timings_so_far: Vec<(String, String)> = run
         .timings
         .iter()

@@ -20,8 +20,10 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 
 use flapssm_data::{Dataset, OUTPUT_NAMES, Trajectory};
-use flapssm_prssm::train::fit::{FitError, FitOutcome, FitSpec, Preset, fit, predict_raw, training_record};
-use flapssm_prssm::train::{Budget, Checkpoint, TrainEvent, TrainHooks, derive_seed};
+use flapssm_prssm::train::fit::{
+    FitError, FitOutcome, FitSpec, Preset, fit, predict_raw, training_record,
+};
+use flapssm_prssm::train::{Budget, Checkpoint, LrSchedule, TrainEvent, TrainHooks, derive_seed};
 use flapssm_prssm::{PrssmModel, Sequence};
 use flapssm_qs::{InterceptMode, LrqsmModel, QsError};
 use flapssm_wing::cycles::{CycleError, published_window};
@@ -756,10 +758,7 @@ pub fn evaluate(
     table
         .write_csv(&p_peaks, &state_names, &input_names)
         .map_err(analysis(p_peaks.display().to_string()))?;
-    write_text(
-        &file("trajectories.csv"),
-        &trajectories_csv(&trajectories),
-    )?;
+    write_text(&file("trajectories.csv"), &trajectories_csv(&trajectories))?;
     write_predictions(&file("predictions.npz"), ds, &pp, &lq, dx)?;
 
     // Figures.
@@ -797,7 +796,10 @@ pub fn evaluate(
     draw_fig3(&f_3, ds, &prep, &examples, &labels)?;
     let names5: Vec<&str> = COEFFICIENT_LABELS.to_vec();
     let edges = Histogram::uniform_edges(-1.1, 1.1, 0.01);
-    let out_names = OUTPUT_NAMES.iter().map(|s| format!("{s}/σ")).collect::<Vec<_>>();
+    let out_names = OUTPUT_NAMES
+        .iter()
+        .map(|s| format!("{s}/σ"))
+        .collect::<Vec<_>>();
     let out_refs: Vec<&str> = out_names.iter().map(String::as_str).collect();
     for (path, set, label) in [(&f_4a_train, &train, "train"), (&f_4a_test, &test, "test")] {
         if set.is_empty() {
@@ -970,7 +972,10 @@ fn draw_fig3(
                 t: (0..=p.window.duration)
                     .map(|k| k as f64 / p.window.duration as f64)
                     .collect(),
-                euler: range.clone().map(|k| ds.trajectories[i].euler_rad[k]).collect(),
+                euler: range
+                    .clone()
+                    .map(|k| ds.trajectories[i].euler_rad[k])
+                    .collect(),
                 cols: [
                     pair(&p.measured_c),
                     pair(&p.prssm_c),
@@ -1479,6 +1484,8 @@ pub struct TrainingOptions {
     pub batch: Option<usize>,
     /// Adam learning rate.
     pub lr: Option<f64>,
+    /// Learning-rate schedule.
+    pub schedule: Option<LrSchedule>,
     /// Evaluate (best-model tracking) every this many epochs.
     pub eval_every: Option<u64>,
     /// Seed of initialization, shuffles and draws.
@@ -1500,6 +1507,7 @@ impl Default for TrainingOptions {
             epochs: None,
             batch: None,
             lr: None,
+            schedule: None,
             eval_every: None,
             seed: 0,
             val_fraction: 0.1,
@@ -1531,6 +1539,9 @@ impl TrainingOptions {
         if let Some(v) = self.lr {
             spec.train.lr = v;
         }
+        if let Some(v) = self.schedule {
+            spec.train.schedule = v;
+        }
         if let Some(v) = self.eval_every {
             spec.train.eval_every = v;
         }
@@ -1555,8 +1566,8 @@ impl TrainingOptions {
                 found: format!("{} of {} trajectories", self.val_fraction, train.len()),
             });
         }
-        let n_val = ((train.len() as f64 * self.val_fraction).round() as usize)
-            .min(train.len() - 1);
+        let n_val =
+            ((train.len() as f64 * self.val_fraction).round() as usize).min(train.len() - 1);
         Ok(train.split_at(train.len() - n_val))
     }
 }
@@ -1694,13 +1705,9 @@ mod tests {
     #[test]
     fn metrics_agree_with_independent_computations() {
         let ds = tiny_dataset();
-        let lrqsm = flapssm_qs::lrqsm::fit_dataset(
-            &ds,
-            Default::default(),
-            &Default::default(),
-            "tiny",
-        )
-        .unwrap();
+        let lrqsm =
+            flapssm_qs::lrqsm::fit_dataset(&ds, Default::default(), &Default::default(), "tiny")
+                .unwrap();
         let q = flapssm_qs::lrqsm::predict_dataset(&lrqsm, &ds, InterceptMode::Fitted).unwrap();
         let opts = TrainingOptions {
             dx: Some(5),
@@ -1737,7 +1744,8 @@ mod tests {
         for j in 0..5 {
             assert!((lt.rmse_standardized[j] - qt.standardized[j]).abs() < 1e-10);
             assert!(
-                (r.lrqsm.train.rmse_standardized[j] - q.rmse_train.as_ref().unwrap().standardized[j])
+                (r.lrqsm.train.rmse_standardized[j]
+                    - q.rmse_train.as_ref().unwrap().standardized[j])
                     .abs()
                     < 1e-10
             );
@@ -1746,7 +1754,10 @@ mod tests {
         let ms: f64 = pt.rmse_standardized.iter().map(|v| v * v).sum::<f64>() / 5.0;
         assert!((pt.overall_rmse_standardized - ms.sqrt()).abs() < 1e-12);
         for j in 0..5 {
-            assert_eq!(r.rmse_ratio[j], pt.rmse_standardized[j] / lt.rmse_standardized[j]);
+            assert_eq!(
+                r.rmse_ratio[j],
+                pt.rmse_standardized[j] / lt.rmse_standardized[j]
+            );
         }
         for (t, m) in ds.trajectories.iter().zip(&r.trajectories) {
             let stroke: Vec<f64> = t.euler_rad.iter().map(|e| e[0]).collect();
@@ -1763,8 +1774,7 @@ mod tests {
     #[test]
     fn model_of_the_wrong_shape_is_rejected() {
         let ds = tiny_dataset();
-        let mut cfg = flapssm_prssm::ModelConfig::new(4, 2, 3, 5);
-        cfg.n_inducing = 5;
+        let cfg = flapssm_prssm::ModelConfig::new(4, 2, 3, 5);
         let params = flapssm_prssm::Params::init(&cfg, &Default::default(), 1);
         let m = PrssmModel {
             config: cfg,

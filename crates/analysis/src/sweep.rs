@@ -63,7 +63,9 @@ impl std::str::FromStr for SweepKind {
         match s {
             "dx" => Ok(SweepKind::Dx),
             "data-size" => Ok(SweepKind::DataSize),
-            _ => Err(format!("unknown sweep kind {s:?} (expected dx or data-size)")),
+            _ => Err(format!(
+                "unknown sweep kind {s:?} (expected dx or data-size)"
+            )),
         }
     }
 }
@@ -202,12 +204,11 @@ pub fn sweep_run(
             &rows(&meas[r.clone()])?,
             &rows(&predz[r.clone()])?,
             start_sample,
-        ).map_err(
-            |source| PipelineError::Analysis {
-                what: "sweep errors".into(),
-                source,
-            },
-        )?;
+        )
+        .map_err(|source| PipelineError::Analysis {
+            what: "sweep errors".into(),
+            source,
+        })?;
         Ok(Some(SetRmse {
             n_trajectories: r.len(),
             rmse_standardized: e.rmse(),
@@ -345,7 +346,11 @@ impl SweepTable {
                     opt(r.test_rmse.as_ref().and_then(|v| v.get(j).copied()))
                 ));
             }
-            s.push_str(&format!(",{},{}\n", r.train_wall_s, r.source.replace(',', ";")));
+            s.push_str(&format!(
+                ",{},{}\n",
+                r.train_wall_s,
+                r.source.replace(',', ";")
+            ));
         }
         s
     }
@@ -363,11 +368,10 @@ impl SweepTable {
         )?;
         save_json(&table.with_extension("json"), self)?;
         let fig = table.with_extension("png");
-        self.figure(&fig)
-            .map_err(|source| PipelineError::Analysis {
-                what: "sweep figure".into(),
-                source,
-            })
+        self.figure(&fig).map_err(|source| PipelineError::Analysis {
+            what: "sweep figure".into(),
+            source,
+        })
     }
 
     /// Overall training and test RMSE vs the swept value, one panel per kind (mean over seeds
@@ -413,7 +417,10 @@ impl SweepTable {
                 let mut values: Vec<usize> = rows.iter().map(|r| r.value).collect();
                 values.dedup();
                 for (c, (label, get)) in [
-                    ("training", (|r: &SweepRow| Some(r.train_overall)) as fn(&SweepRow) -> Option<f64>),
+                    (
+                        "training",
+                        (|r: &SweepRow| Some(r.train_overall)) as fn(&SweepRow) -> Option<f64>,
+                    ),
                     ("test", |r: &SweepRow| r.test_overall),
                 ]
                 .into_iter()

@@ -518,3 +518,83 @@ pub fn run(
     };
     Ok((report, trace))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn scores_match_hand_computed_values() {
+        // Two outputs with training stds 2 and 0.5; raw errors (2, 0.5) and (0, -1).
+        let std = [2.0, 0.5];
+        let y = [1.0, 1.0, 3.0, 0.0];
+        let m = [-1.0, 0.5, 3.0, 1.0];
+        let v = [4.0, 0.25, 16.0, 1.0];
+        let s = score(&y, &m, &v, &std);
+        assert!((s.rmse - ((4.0 + 0.25 + 0.0 + 1.0) / 4.0f64).sqrt()).abs() < 1e-15);
+        // Standardized: (e, v) = (1, 1), (1, 1), (0, 4), (-2, 4).
+        let ln2pi = (2.0 * std::f64::consts::PI).ln();
+        let nll = [
+            0.5 * ln2pi + 0.5,
+            0.5 * ln2pi + 0.5,
+            0.5 * (ln2pi + 4f64.ln()),
+            0.5 * (ln2pi + 4f64.ln()) + 0.5,
+        ];
+        assert!((s.nll - nll.iter().sum::<f64>() / 4.0).abs() < 1e-14);
+    }
+
+    #[test]
+    fn mean_std_is_population_std() {
+        let ms = MeanStd::of([1.0, 2.0, 3.0, 6.0]);
+        assert_eq!(ms.mean, 3.0);
+        assert!((ms.std - 3.5f64.sqrt()).abs() < 1e-15);
+    }
+
+    #[test]
+    fn record_is_row_major_in_selection_order() {
+        let table = Table {
+            source: "t.csv".into(),
+            names: vec!["a".into(), "b".into(), "c".into()],
+            columns: vec![vec![1.0, 2.0, 3.0], vec![4.0, 5.0, 6.0], vec![7.0, 8.0, 9.0]],
+        };
+        let r = IoRecord::from_table(
+            &table,
+            &[Column::Name("c".into()), Column::Index(0)],
+            &[Column::Index(1)],
+        )
+        .unwrap();
+        assert_eq!(r.input_names, ["c", "a"]);
+        assert_eq!(r.inputs, [7.0, 1.0, 8.0, 2.0, 9.0, 3.0]);
+        assert_eq!(r.outputs, [4.0, 5.0, 6.0]);
+        assert_eq!(r.n_samples(), 3);
+        let h = r.head(2);
+        assert_eq!((h.inputs.len(), h.outputs), (4, vec![4.0, 5.0]));
+        let s = r.sequence(1..3);
+        assert_eq!((s.inputs, s.outputs), (vec![8.0, 2.0, 9.0, 3.0], vec![5.0, 6.0]));
+    }
+
+    #[test]
+    fn split_counts_enforce_minimum_training_samples() {
+        assert_eq!(split_counts(0.5, 1000, 16).unwrap(), (500, 500));
+        assert_eq!(split_counts(0.1, 1000, 16).unwrap(), (100, 900));
+        let e = split_counts(0.099, 1000, 16).unwrap_err().to_string();
+        assert!(e.contains("99 training") && e.contains("at least 100"), "{e}");
+        assert!(split_counts(0.99, 1000, 16).is_err());
+    }
+
+    #[test]
+    fn mismatched_fit_sizes_and_bad_settings_are_rejected() {
+        let spec = SysidSpec::reference(2, 1);
+        assert!(spec.check(2, 1).is_ok());
+        let e = spec.check(1, 1).unwrap_err().to_string();
+        assert!(e.contains("1 inputs and 1 outputs"), "{e}");
+        let e = SysidSpec {
+            seeds: 0,
+            ..SysidSpec::reference(1, 1)
+        }
+        .check(1, 1)
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("seeds"), "{e}");
+    }
+}

@@ -41,7 +41,17 @@ fn tiny_demo_evaluate_and_sweep() {
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path().join("demo");
     let d = dir.to_str().unwrap();
-    ok(&["demo", "--out", d, "--trajectories", "8", "--epochs", "3", "--seed", "5"]);
+    ok(&[
+        "demo",
+        "--out",
+        d,
+        "--trajectories",
+        "8",
+        "--epochs",
+        "3",
+        "--seed",
+        "5",
+    ]);
 
     // summary.json: headline numbers, consistent with each other.
     let s = json(&dir.join("summary.json"));
@@ -63,7 +73,10 @@ fn tiny_demo_evaluate_and_sweep() {
         r.iter().all(|v| *v <= 0.6)
     );
     let lag = s["a_x_median_lag_cycles"].as_f64().unwrap();
-    assert!(lag > 0.0 && lag < 1.0, "lags are within (0, 1) cycle: {lag}");
+    assert!(
+        lag > 0.0 && lag < 1.0,
+        "lags are within (0, 1) cycle: {lag}"
+    );
     assert_eq!(s["authority"].as_array().unwrap().len(), 10);
     let stages: Vec<&str> = s["timings"]
         .as_array()
@@ -92,7 +105,17 @@ fn tiny_demo_evaluate_and_sweep() {
     assert_eq!(auth.lines().count(), 1 + 8 * 7, "D_x 8 states × 7 inputs");
 
     // A rerun with the same configuration skips every stage.
-    ok(&["demo", "--out", d, "--trajectories", "8", "--epochs", "3", "--seed", "5"]);
+    ok(&[
+        "demo",
+        "--out",
+        d,
+        "--trajectories",
+        "8",
+        "--epochs",
+        "3",
+        "--seed",
+        "5",
+    ]);
     let s2 = json(&dir.join("summary.json"));
     assert!(
         s2["timings"]
@@ -128,9 +151,24 @@ fn tiny_demo_evaluate_and_sweep() {
     for (kind, value) in [("dx", "6"), ("data-size", "4")] {
         let out = tmp.path().join(format!("sweep-{kind}.json"));
         ok(&[
-            "sweep", "run", "--kind", kind, "--value", value, "--dataset",
-            ds.to_str().unwrap(), "--out", out.to_str().unwrap(), "--epochs", "2",
-            "--inducing", "8", "--particles", "4", "--eval-particles", "4",
+            "sweep",
+            "run",
+            "--kind",
+            kind,
+            "--value",
+            value,
+            "--dataset",
+            ds.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--epochs",
+            "2",
+            "--inducing",
+            "8",
+            "--particles",
+            "4",
+            "--eval-particles",
+            "4",
         ]);
         let r = json(&out);
         assert_eq!(r["kind"], kind);
@@ -150,20 +188,40 @@ fn tiny_demo_evaluate_and_sweep() {
 
     // Bad input: clear errors naming the file or value, nonzero exit.
     let o = flapssm(&[
-        "sweep", "run", "--kind", "data-size", "--value", "99", "--dataset",
-        ds.to_str().unwrap(), "--out", tmp.path().join("x.json").to_str().unwrap(),
+        "sweep",
+        "run",
+        "--kind",
+        "data-size",
+        "--value",
+        "99",
+        "--dataset",
+        ds.to_str().unwrap(),
+        "--out",
+        tmp.path().join("x.json").to_str().unwrap(),
     ]);
     assert!(!o.status.success());
     assert!(String::from_utf8_lossy(&o.stderr).contains("data-size value"));
     let missing = tmp.path().join("missing.json");
     let o = flapssm(&[
-        "evaluate", "--dataset", ds.to_str().unwrap(), "--prssm",
-        missing.to_str().unwrap(), "--lrqsm", missing.to_str().unwrap(), "--out",
+        "evaluate",
+        "--dataset",
+        ds.to_str().unwrap(),
+        "--prssm",
+        missing.to_str().unwrap(),
+        "--lrqsm",
+        missing.to_str().unwrap(),
+        "--out",
         tmp.path().join("e2").to_str().unwrap(),
     ]);
     assert!(!o.status.success());
     assert!(String::from_utf8_lossy(&o.stderr).contains("missing.json"));
-    let o = flapssm(&["sweep", "merge", "--out", table.to_str().unwrap(), ds.to_str().unwrap()]);
+    let o = flapssm(&[
+        "sweep",
+        "merge",
+        "--out",
+        table.to_str().unwrap(),
+        ds.to_str().unwrap(),
+    ]);
     assert!(!o.status.success());
     assert!(String::from_utf8_lossy(&o.stderr).contains("dataset.npz"));
 }

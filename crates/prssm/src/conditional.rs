@@ -19,7 +19,9 @@
 use faer::Accum;
 
 use crate::kernel::{self, KernelKind};
-use crate::linalg::{cholesky_backward, cholesky_in_place, gemm, lower_inverse, view, view_mut};
+use crate::linalg::{
+    cholesky_backward, cholesky_in_place, dot, gemm, lower_inverse, view, view_mut,
+};
 use crate::objective::ObjectiveError;
 use crate::params::{CovarianceStructure, ModelConfig, Parametrization, Params};
 
@@ -357,8 +359,8 @@ impl ConditionalWorkspace {
                         1.0,
                     );
                     for j in 0..n {
-                        let s: f64 = self.w2[j * m..(j + 1) * m].iter().map(|v| v * v).sum();
-                        self.var[j * dx + dd] = s;
+                        let c = &self.w2[j * m..(j + 1) * m];
+                        self.var[j * dx + dd] = dot(c, c);
                     }
                 }
             }
@@ -369,8 +371,7 @@ impl ConditionalWorkspace {
             .zip(h.chunks_exact(m))
             .zip(self.var.chunks_exact_mut(dx))
         {
-            let s: f64 = wc.iter().zip(hc).map(|(a, b)| a * b).sum();
-            let base = post.variance - s;
+            let base = post.variance - dot(wc, hc);
             v.iter_mut().for_each(|v| *v += base);
         }
     }
@@ -526,13 +527,8 @@ impl ConditionalWorkspace {
             view(k, m, n).transpose(),
             1.0,
         );
-        let inv_var = 1.0 / post.variance;
-        let mut sv = 0.0;
-        for ((kb, &kv), &kd) in kbar.iter_mut().zip(k).zip(&*t.kd) {
-            sv += *kb * kv;
-            *kb *= kd;
-        }
-        grads.variance += sv * inv_var;
+        grads.variance += dot(kbar, k) / post.variance;
+        kbar.iter_mut().zip(&*t.kd).for_each(|(kb, &kd)| *kb *= kd);
         kernel::cross_cov_backward(
             kbar,
             &post.zt,

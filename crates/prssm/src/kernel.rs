@@ -70,17 +70,18 @@ pub fn exp(x: f64) -> f64 {
     let kf = t - SHIFT;
     let k = t.to_bits() as i64 - SHIFT.to_bits() as i64;
     let r = (x - kf * LN2_HI) - kf * LN2_LO;
+    // Σ_{i≥4} cᵢ r^{i−4} by Estrin's scheme, then the low orders by Horner (accuracy).
     let r2 = r * r;
     let r4 = r2 * r2;
-    let r8 = r4 * r4;
     let a = |i: usize| C[i + 1].mul_add(r, C[i]);
-    let b0 = a(2).mul_add(r2, a(0));
-    let b1 = a(6).mul_add(r2, a(4));
-    let b2 = a(10).mul_add(r2, a(8));
-    let b3 = a(12);
-    let lo = b1.mul_add(r4, b0);
-    let hi = b3.mul_add(r4, b2);
-    let p = hi.mul_add(r8, lo);
+    let b0 = a(6).mul_add(r2, a(4));
+    let b1 = a(10).mul_add(r2, a(8));
+    let q = a(12).mul_add(r4 * r4, b1.mul_add(r4, b0));
+    let p = q
+        .mul_add(r, C[3])
+        .mul_add(r, C[2])
+        .mul_add(r, C[1])
+        .mul_add(r, C[0]);
     let k1 = k >> 1;
     let s1 = f64::from_bits(((k1 + 1023) as u64) << 52);
     let s2 = f64::from_bits(((k - k1 + 1023) as u64) << 52);
@@ -245,7 +246,7 @@ pub fn cross_cov_backward(
         len_acc[j] += l;
     }
     for n in 0..n_pts {
-        let s: f64 = c[n * m_n..(n + 1) * m_n].iter().sum();
+        let s = crate::linalg::sum(&c[n * m_n..(n + 1) * m_n]);
         for j in 0..d {
             let x = xs[n * d + j];
             len_acc[j] += x * x * s;

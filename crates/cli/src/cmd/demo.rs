@@ -174,7 +174,11 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
             "  {:<10} {:>8.1} s{}",
             t.stage,
             t.wall_s,
-            if t.skipped { " (skipped, earlier run)" } else { "" }
+            if t.skipped {
+                " (skipped, earlier run)"
+            } else {
+                ""
+            }
         );
     }
     println!("total {:.1} s", s.total_wall_s);

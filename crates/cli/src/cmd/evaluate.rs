@@ -79,12 +79,19 @@ pub fn run(a: EvaluateArgs) -> anyhow::Result<()> {
             .join(" ")
     };
     for m in [&r.prssm, &r.lrqsm] {
-        println!("{:<7} train RMSE (σ) {}", m.model, f(&m.train.rmse_standardized));
+        println!(
+            "{:<7} train RMSE (σ) {}",
+            m.model,
+            f(&m.train.rmse_standardized)
+        );
         if let Some(t) = &m.test {
             println!("{:<7} test  RMSE (σ) {}", m.model, f(&t.rmse_standardized));
         }
     }
     println!("ratio PR-SSM/LRQSM    {}", f(&r.rmse_ratio));
-    println!("wrote {} (report.html, metrics.json, figures)", a.out.display());
+    println!(
+        "wrote {} (report.html, metrics.json, figures)",
+        a.out.display()
+    );
     Ok(())
 }

@@ -104,6 +104,7 @@ fn run_one(a: RunArgs) -> anyhow::Result<()> {
         epochs: a.epochs,
         batch: a.batch,
         lr: a.lr,
+        schedule: None,
         eval_every: a.eval_every,
         seed: a.seed,
         val_fraction: a.val_fraction,
@@ -122,7 +123,14 @@ fn run_one(a: RunArgs) -> anyhow::Result<()> {
         &Bars::new(),
         Some(&stop),
     )
-    .with_context(|| format!("sweep {} = {} on {}", a.kind.name(), a.value, a.dataset.display()))?;
+    .with_context(|| {
+        format!(
+            "sweep {} = {} on {}",
+            a.kind.name(),
+            a.value,
+            a.dataset.display()
+        )
+    })?;
     save_json(&a.out, &r).with_context(|| format!("writing {}", a.out.display()))?;
     println!(
         "{} = {}: train RMSE {:.4}, test RMSE {}, {:.1} s -> {}",
@@ -153,9 +161,6 @@ fn merge(a: MergeArgs) -> anyhow::Result<()> {
         .write(&a.out)
         .with_context(|| format!("writing {}", a.out.display()))?;
     print!("{}", table.to_csv());
-    println!(
-        "wrote {} (+ .json, .png)",
-        a.out.display()
-    );
+    println!("wrote {} (+ .json, .png)", a.out.display());
     Ok(())
 }

@@ -46,6 +46,9 @@ pub struct LdvmDiagnostics {
     pub lev_m2_s: f64,
     /// Number of free vortices after this step.
     pub n_vortices: usize,
+    /// Terms of N' (N/m): [ρV_t cπ(B0 + B1/2) (circulatory, plate motion), ρΣ u_t,j Γ_j (free-vortex
+    /// induced), ρπc²(¾Ḃ0 + ¼Ḃ1 + ⅛Ḃ2) (unsteady)].
+    pub normal_terms_n_m: [f64; 3],
 }
 
 /// 2-D LDVM for a flat plate. Built once, stepped with [`Ldvm::step`]; all storage is
@@ -346,8 +349,12 @@ impl Ldvm {
         };
         let (b0, b1, b2, b3) = (self.b[0], self.b[1], self.b[2], self.b[3]);
         let vt = -vpt;
-        let normal = rho * (vt * kb(b0, b1) + sum_ut)
-            + rho * PI * c * c * (NF[0] * bd(0, self) + NF[1] * bd(1, self) + NF[2] * bd(2, self));
+        let n_terms = [
+            rho * vt * kb(b0, b1),
+            rho * sum_ut,
+            rho * PI * c * c * (NF[0] * bd(0, self) + NF[1] * bd(1, self) + NF[2] * bd(2, self)),
+        ];
+        let normal = n_terms[0] + n_terms[1] + n_terms[2];
         let m_le = rho * (vt * c * c * PI * (0.25 * b0 + 0.25 * b1 - 0.125 * b2) + sum_xut)
             + rho
                 * PI
@@ -363,8 +370,16 @@ impl Ldvm {
         };
 
         // free-vortex velocities for the next convection
+        let sheet = BoundSheet {
+            le,
+            t: [tx, tz],
+            n: [nx, nz],
+            c,
+            eps4: (4.0 * self.p.core_radius_frac).powi(2),
+            b: &self.b,
+        };
         self.wake
-            .compute_velocities(&self.bx, &self.bz, &self.bg_ccw, self.rc4);
+            .compute_velocities(self.rc4, |x, z| sheet.velocity_at(x, z));
         self.diag = LdvmDiagnostics {
             lesp: b0 / self.p.u_ref_m_s,
             lesp_unshed: lesp0,
@@ -373,6 +388,7 @@ impl Ldvm {
             tev_m2_s: g_tev,
             lev_m2_s: g_lev,
             n_vortices: self.wake.len(),
+            normal_terms_n_m: n_terms,
         };
         self.b_prev2.copy_from_slice(&self.b_prev);
         self.b_prev.copy_from_slice(&self.b);
@@ -475,6 +491,74 @@ impl Ldvm {
             .map(|(q, w)| q * w)
             .sum()
     }
+}
+
+/// The bound vortex sheet of the plate, γ(θ) = 2[B0 (1 + cos θ)/sin θ + Σ B_n sin nθ].
+///
+/// Its velocity off the plate is exact for the truncated series (conformal map of the plate to
+/// the unit circle): in plate axes (x along t̂ from the LE, z along n̂), with
+/// x + iz − c/2 = −(c/4)(σ + 1/σ), |σ| ≥ 1,
+///
+/// u − iw = −2iB0/(σ − 1) − i Σ_{n≥1} B_n σ^{−n}   (m/s).
+///
+/// On the plate this gives w = −B0 + Σ B_n cos nθ (cancelling the downwash W_n) and the jump
+/// u_upper − u_lower = γ. The square-root singularity at the LE is regularised over the vortex
+/// core: 1/(σ − 1) → conj(σ − 1)/√(|σ − 1|⁴ + ε⁴), ε² = 4 r_c/c (|σ − 1|² ≈ 4r/c at distance r).
+pub(crate) struct BoundSheet<'a> {
+    pub le: [f64; 2],
+    pub t: [f64; 2],
+    pub n: [f64; 2],
+    pub c: f64,
+    pub eps4: f64,
+    pub b: &'a [f64],
+}
+
+impl BoundSheet<'_> {
+    /// Velocity (m/s, inertial axes) induced by the sheet at (px, pz).
+    pub fn velocity_at(&self, px: f64, pz: f64) -> (f64, f64) {
+        let (dx, dz) = (px - self.le[0], pz - self.le[1]);
+        let x = dx * self.t[0] + dz * self.t[1];
+        let z = dx * self.n[0] + dz * self.n[1];
+        // s = 2(x + iz − c/2)/c; σ = −s ± √(s² − 1), the root outside the unit circle
+        let (sr, si) = (2.0 * x / self.c - 1.0, 2.0 * z / self.c);
+        let (qr, qi) = csqrt(sr * sr - si * si - 1.0, 2.0 * sr * si);
+        let (a, b) = ((-sr + qr, -si + qi), (-sr - qr, -si - qi));
+        let sig = if a.0 * a.0 + a.1 * a.1 >= b.0 * b.0 + b.1 * b.1 {
+            a
+        } else {
+            b
+        };
+        // 1/(σ − 1), regularised
+        let (er, ei) = (sig.0 - 1.0, sig.1);
+        let m2 = er * er + ei * ei;
+        let inv = 1.0 / (m2 * m2 + self.eps4).sqrt();
+        let (ir, ii) = (er * inv, -ei * inv);
+        // F = u − iw = −i[2B0/(σ − 1) + Σ B_n σ^{−n}]
+        let mut fr = 2.0 * self.b[0] * ir;
+        let mut fi = 2.0 * self.b[0] * ii;
+        let d2 = sig.0 * sig.0 + sig.1 * sig.1;
+        let (rr, ri) = (sig.0 / d2, -sig.1 / d2); // 1/σ
+        let (mut pr, mut pi) = (1.0, 0.0);
+        for &bn in &self.b[1..] {
+            (pr, pi) = (pr * rr - pi * ri, pr * ri + pi * rr);
+            fr += bn * pr;
+            fi += bn * pi;
+        }
+        // multiply by −i: (fr + i fi)(−i) = fi − i fr  →  u = fi, w = fr
+        let (u, w) = (fi, fr);
+        (
+            u * self.t[0] + w * self.n[0],
+            u * self.t[1] + w * self.n[1],
+        )
+    }
+}
+
+/// Principal square root of a + ib.
+fn csqrt(a: f64, b: f64) -> (f64, f64) {
+    let r = a.hypot(b);
+    let re = (0.5 * (r + a)).max(0.0).sqrt();
+    let im = (0.5 * (r - a)).max(0.0).sqrt();
+    (re, if b < 0.0 { -im } else { im })
 }
 
 #[derive(Clone, Copy)]

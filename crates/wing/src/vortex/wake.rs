@@ -150,12 +150,12 @@ impl Wake {
         (self.x[i], self.z[i])
     }
 
-    /// Sets (u, w) of every vortex to the velocity induced by the other free vortices plus the
-    /// bound elements (bx, bz, counter-clockwise circulations bg). O(N² / 2 + N·n_bound).
-    pub(crate) fn compute_velocities(&mut self, bx: &[f64], bz: &[f64], bg: &[f64], rc4: f64) {
+    /// Sets (u, w) of every vortex to the velocity induced by the other free vortices plus
+    /// `sheet(x, z)`, the velocity of the bound vortex sheet at (x, z). O(N²/2 + N·cost(sheet)).
+    pub(crate) fn compute_velocities(&mut self, rc4: f64, sheet: impl Fn(f64, f64) -> (f64, f64)) {
         let n = self.len();
         for i in 0..n {
-            let (u, w) = induced_at(self.x[i], self.z[i], bx, bz, bg, rc4);
+            let (u, w) = sheet(self.x[i], self.z[i]);
             self.u[i] = u;
             self.w[i] = w;
         }
@@ -380,7 +380,7 @@ mod tests {
             wake.push(x, z, g, VortexKind::Tev);
         }
         let rc4 = 0.01f64.powi(4);
-        wake.compute_velocities(&[], &[], &[], rc4);
+        wake.compute_velocities(rc4, |_, _| (0.0, 0.0));
         for (i, &(x, z, _)) in pts.iter().enumerate() {
             let (mut u, mut w) = (0.0, 0.0);
             for (j, &(xj, zj, gj)) in pts.iter().enumerate() {

@@ -1,0 +1,56 @@
+//! TEMPORARY diagnostics (to be deleted).
+use std::f64::consts::PI;
+use flapssm_wing::vortex::{Ldvm, LdvmParams, PlateState, VortexKind};
+
+fn eldredge(t: f64) -> (f64, f64) {
+    let (amp, k, sigma) = (PI / 4.0, 0.4, 0.8);
+    let a = PI * PI * k / (2.0 * amp * (1.0 - sigma));
+    let (t1, t2) = (1.0, 1.0 + amp / (2.0 * k));
+    let lc = |x: f64| x.abs() + (1.0 + (-2.0 * x.abs()).exp()).ln() - 2f64.ln();
+    let al = 0.5 * amp * (1.0 + (lc(a * (t - t1)) - lc(a * (t - t2))) / (a * (t2 - t1)));
+    let ad = 0.5 * amp * ((a * (t - t1)).tanh() - (a * (t - t2)).tanh()) / (t2 - t1);
+    (al, ad)
+}
+
+#[test]
+fn diag_eldredge() {
+    let core: f64 = std::env::var("CORE").ok().and_then(|s| s.parse().ok()).unwrap_or(0.02);
+    let nch: usize = std::env::var("NCH").ok().and_then(|s| s.parse().ok()).unwrap_or(24);
+    let p = LdvmParams {
+        chord_m: 1.0, u_ref_m_s: 1.0, rho_kg_m3: 1.0, pivot_frac: 0.0,
+        lesp_crit: Some(0.11), lev_decay_chords: None, tev_decay_chords: None,
+        far_field_chords: None, max_vortices: 400, core_radius_frac: core, n_chord: nch,
+        ..LdvmParams::default()
+    };
+    let dt = 0.015;
+    let mut l = Ldvm::new(p).unwrap();
+    for k in 0..((5.0 / dt) as usize) {
+        let t = k as f64 * dt;
+        let (a, ad) = eldredge(t);
+        let plate = PlateState { pivot_m: [-t, 0.0], pivot_vel_m_s: [-1.0, 0.0], angle_rad: -a, angle_rate_rad_s: -ad };
+        let ld = l.step(&plate, dt).unwrap();
+        let d = *l.diagnostics();
+        let th = -a;
+        let (s, c) = th.sin_cos();
+        let (tx, tz, nx, nz) = (c, s, -s, c);
+        let cl = ld.normal_n_m * nz + ld.chord_n_m * tz;
+        let w = l.wake();
+        let (mut nl, mut gl, mut dmin, mut xcen, mut gsum) = (0, 0.0, f64::INFINITY, 0.0, 0.0);
+        for i in 0..w.len() {
+            if w.kinds()[i] == VortexKind::Lev {
+                nl += 1;
+                gl += w.gamma_m2_s()[i];
+                let (dx, dz) = (w.x_m()[i] - plate.pivot_m[0], w.z_m()[i] - plate.pivot_m[1]);
+                let xn = dx * nx + dz * nz;
+                let xt = dx * tx + dz * tz;
+                if xt < 1.2 { dmin = dmin.min(xn); }
+                xcen += xt * w.gamma_m2_s()[i];
+                gsum += w.gamma_m2_s()[i];
+            }
+        }
+        if k % 5 == 0 {
+            println!("t {t:.3} a {:5.1} CL {cl:7.3} CN [{:7.3} {:7.3} {:7.3}] A0 {:6.3} A0u {:6.3} nlev {nl} GL {gl:7.3} dmin {dmin:6.3} xc {:6.3}",
+                a.to_degrees(), 2.0*d.normal_terms_n_m[0], 2.0*d.normal_terms_n_m[1], 2.0*d.normal_terms_n_m[2], d.lesp, d.lesp_unshed, if gsum != 0.0 { xcen / gsum } else { 0.0 });
+        }
+    }
+}
