@@ -396,6 +396,9 @@ pub struct ReportContext {
     pub config: serde_json::Value,
 }
 
+/// Picks a model's (standardized, coefficient) tables from a [`Prepared`].
+type Pick<'p> = &'p dyn Fn(&Prepared) -> (&[f64], &[f64]);
+
 /// One trajectory's tables for the analyses.
 struct Prepared {
     window: CycleWindow,
@@ -414,7 +417,7 @@ fn rows<'a>(v: &'a [f64], c: usize, what: &str) -> Result<Rows<'a>> {
 
 fn split_metrics(
     prep: &[&Prepared],
-    pick: &dyn Fn(&Prepared) -> (&[f64], &[f64]),
+    pick: Pick<'_>,
     opts: &EvalOptions,
     what: &str,
 ) -> Result<SplitMetrics> {
@@ -636,7 +639,7 @@ pub fn evaluate(
     fn pick_l(p: &Prepared) -> (&[f64], &[f64]) {
         (&p.lrqsm_z, &p.lrqsm_c)
     }
-    let model_metrics = |name: &str, pick: &dyn Fn(&Prepared) -> (&[f64], &[f64])| {
+    let model_metrics = |name: &str, pick: Pick<'_>| {
         Ok::<_, PipelineError>(ModelMetrics {
             model: name.into(),
             train: split_metrics(&train, pick, opts, &format!("{name} training metrics"))?,
@@ -724,11 +727,11 @@ pub fn evaluate(
     .map_err(analysis("control-authority summary"))?;
     let mut authority_findings = Vec::new();
     for input in [0usize, 2] {
-        for state in 0..5.min(dx) {
+        for (state, state_name) in state_names.iter().enumerate().take(5) {
             let s = summary.pair(state, input);
             authority_findings.push(AuthorityFinding {
                 input: input_names[input].clone(),
-                state: state_names[state].clone(),
+                state: state_name.clone(),
                 median_abs_r: s.median_abs_r,
                 median_lag_cycles: s.median_lag_cycles,
                 lag_iqr_cycles: s.lag_iqr_cycles,

@@ -318,7 +318,7 @@ impl SweepTable {
                 source: src.clone(),
             })
             .collect();
-        rows.sort_by(|a, b| (a.kind, a.value, a.seed).cmp(&(b.kind, b.value, b.seed)));
+        rows.sort_by_key(|a| (a.kind, a.value, a.seed));
         Ok(Self { rows })
     }
 

@@ -72,7 +72,7 @@ pub enum SysidError {
         min_test: usize,
     },
     /// Fitting or predicting failed.
-    #[error("seed {seed}: {source}")]
+    #[error("run with seed {seed} failed")]
     Fit {
         /// Seed of the failed run.
         seed: u64,
@@ -294,6 +294,10 @@ pub struct SeedRun {
     pub wall_s: f64,
     /// Steps rejected by the divergence guard.
     pub rejected_steps: u64,
+    /// Epoch of the selected model (lowest open-loop RMSE on the training part).
+    pub best_epoch: Option<u64>,
+    /// That open-loop RMSE on the training part (standardized units).
+    pub best_train_rmse: Option<f64>,
     /// Test scores of the last (not the selected best) parameters, when asked for.
     pub last_test: Option<Scores>,
 }
@@ -457,7 +461,12 @@ pub fn run(
                     derive_seed(seed, PREDICT_STREAM, 0),
                 )
                 .map_err(err)?;
-                Some(score(&test.outputs, &p.output_mean, &p.output_var, &norm.output_std))
+                Some(score(
+                    &test.outputs,
+                    &p.output_mean,
+                    &p.output_var,
+                    &norm.output_std,
+                ))
             }
             false => None,
         };
@@ -489,6 +498,8 @@ pub fn run(
             rmse_per_output,
             wall_s,
             rejected_steps: out.outcome.state.rejected,
+            best_epoch: out.outcome.state.best.as_ref().map(|b| b.epoch),
+            best_train_rmse: out.outcome.state.best.as_ref().map(|b| b.score),
             last_test: last_scores,
         };
         progress(&r);
@@ -555,7 +566,11 @@ mod tests {
         let table = Table {
             source: "t.csv".into(),
             names: vec!["a".into(), "b".into(), "c".into()],
-            columns: vec![vec![1.0, 2.0, 3.0], vec![4.0, 5.0, 6.0], vec![7.0, 8.0, 9.0]],
+            columns: vec![
+                vec![1.0, 2.0, 3.0],
+                vec![4.0, 5.0, 6.0],
+                vec![7.0, 8.0, 9.0],
+            ],
         };
         let r = IoRecord::from_table(
             &table,
@@ -570,7 +585,10 @@ mod tests {
         let h = r.head(2);
         assert_eq!((h.inputs.len(), h.outputs), (4, vec![4.0, 5.0]));
         let s = r.sequence(1..3);
-        assert_eq!((s.inputs, s.outputs), (vec![8.0, 2.0, 9.0, 3.0], vec![5.0, 6.0]));
+        assert_eq!(
+            (s.inputs, s.outputs),
+            (vec![8.0, 2.0, 9.0, 3.0], vec![5.0, 6.0])
+        );
     }
 
     #[test]
@@ -578,7 +596,10 @@ mod tests {
         assert_eq!(split_counts(0.5, 1000, 16).unwrap(), (500, 500));
         assert_eq!(split_counts(0.1, 1000, 16).unwrap(), (100, 900));
         let e = split_counts(0.099, 1000, 16).unwrap_err().to_string();
-        assert!(e.contains("99 training") && e.contains("at least 100"), "{e}");
+        assert!(
+            e.contains("99 training") && e.contains("at least 100"),
+            "{e}"
+        );
         assert!(split_counts(0.99, 1000, 16).is_err());
     }
 

@@ -49,7 +49,18 @@ enum Command {
     Sysid(cmd::sysid::SysidArgs),
 }
 
+/// Restores the default SIGPIPE action (Rust ignores it), so that writing to a closed pipe
+/// (`flapssm … | head`) ends the process quietly instead of panicking in `println!`.
+fn restore_sigpipe() {
+    #[cfg(unix)]
+    // SAFETY: runs first in `main`, before any other thread exists; SIG_DFL is a valid action.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
+}
+
 fn main() {
+    restore_sigpipe();
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Version => cmd::version(),
@@ -67,7 +78,7 @@ fn main() {
         Command::Sysid(args) => cmd::sysid::run(args),
     };
     if let Err(err) = result {
-        eprintln!("error: {err:#}");
+        eprintln!("error: {}", cmd::error_message(&err));
         std::process::exit(1);
     }
 }

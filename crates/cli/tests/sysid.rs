@@ -46,13 +46,37 @@ fn fails(args: &[&str]) -> String {
 #[test]
 fn unknown_column_lists_available_ones() {
     let csv = sysid_file("actuator.csv");
-    let err = fails(&["sysid", csv.to_str().unwrap(), "--input", "u", "--output", "p"]);
-    assert!(err.contains("'p'") && err.contains("#0 'u', #1 'y'"), "{err}");
+    let err = fails(&[
+        "sysid",
+        csv.to_str().unwrap(),
+        "--input",
+        "u",
+        "--output",
+        "p",
+    ]);
+    assert!(
+        err.contains("'p'") && err.contains("#0 'u', #1 'y'"),
+        "{err}"
+    );
     let mat = sysid_file("drive.mat");
-    let err = fails(&["sysid", mat.to_str().unwrap(), "--input", "u1", "--output", "z9"]);
+    let err = fails(&[
+        "sysid",
+        mat.to_str().unwrap(),
+        "--input",
+        "u1",
+        "--output",
+        "z9",
+    ]);
     assert!(err.contains("z9") && err.contains("z1"), "{err}");
     let dat = sysid_file("ballbeam.dat");
-    let err = fails(&["sysid", dat.to_str().unwrap(), "--input", "0", "--output", "2"]);
+    let err = fails(&[
+        "sysid",
+        dat.to_str().unwrap(),
+        "--input",
+        "0",
+        "--output",
+        "2",
+    ]);
     assert!(err.contains("#2") && err.contains("#1 '1'"), "{err}");
 }
 
@@ -61,23 +85,60 @@ fn corrupt_or_misshaped_files_are_reported() {
     let dir = tempfile::tempdir().unwrap();
     let ragged = dir.path().join("ragged.dat");
     std::fs::write(&ragged, "1 2\n3 4\n5\n").unwrap();
-    let err = fails(&["sysid", ragged.to_str().unwrap(), "--input", "0", "--output", "1"]);
-    assert!(err.contains("ragged.dat") && err.contains("line 3"), "{err}");
+    let err = fails(&[
+        "sysid",
+        ragged.to_str().unwrap(),
+        "--input",
+        "0",
+        "--output",
+        "1",
+    ]);
+    assert!(
+        err.contains("ragged.dat") && err.contains("line 3"),
+        "{err}"
+    );
     let text = dir.path().join("bad.csv");
     std::fs::write(&text, "u,y\n1,2\n3,oops\n").unwrap();
-    let err = fails(&["sysid", text.to_str().unwrap(), "--input", "u", "--output", "y"]);
-    assert!(err.contains("line 3, column 2") && err.contains("oops"), "{err}");
+    let err = fails(&[
+        "sysid",
+        text.to_str().unwrap(),
+        "--input",
+        "u",
+        "--output",
+        "y",
+    ]);
+    assert!(
+        err.contains("line 3, column 2") && err.contains("oops"),
+        "{err}"
+    );
     // A MAT file cut in the middle of its data.
     let bytes = std::fs::read(sysid_file("actuator.mat")).unwrap();
     let cut = dir.path().join("cut.mat");
     std::fs::write(&cut, &bytes[..bytes.len() / 2]).unwrap();
-    let err = fails(&["sysid", cut.to_str().unwrap(), "--input", "u", "--output", "p"]);
+    let err = fails(&[
+        "sysid",
+        cut.to_str().unwrap(),
+        "--input",
+        "u",
+        "--output",
+        "p",
+    ]);
     assert!(err.contains("cut.mat"), "{err}");
     // Input and output variables of different lengths (MAT v4, little-endian doubles).
     let uneven = dir.path().join("uneven.mat");
     std::fs::write(&uneven, [mat_v4("u", 200), mat_v4("y", 150)].concat()).unwrap();
-    let err = fails(&["sysid", uneven.to_str().unwrap(), "--input", "u", "--output", "y"]);
-    assert!(err.contains("uneven.mat") && err.contains("150 rows"), "{err}");
+    let err = fails(&[
+        "sysid",
+        uneven.to_str().unwrap(),
+        "--input",
+        "u",
+        "--output",
+        "y",
+    ]);
+    assert!(
+        err.contains("uneven.mat") && err.contains("150 rows"),
+        "{err}"
+    );
     let err = fails(&["sysid", "no/such/file.csv", "--input", "u", "--output", "y"]);
     assert!(err.contains("no/such/file.csv"), "{err}");
 }
@@ -144,7 +205,10 @@ fn short_run_on_actuator_beats_the_mean_predictor() {
     let mean_rmse = r["mean_predictor_rmse"].as_f64().unwrap();
     assert!((mean_rmse - 1.630).abs() < 5e-4, "{mean_rmse}");
     let rmse = r["rmse"]["mean"].as_f64().unwrap();
-    assert!(rmse < 0.8 * mean_rmse, "test RMSE {rmse} vs mean {mean_rmse}");
+    assert!(
+        rmse < 0.8 * mean_rmse,
+        "test RMSE {rmse} vs mean {mean_rmse}"
+    );
     assert!(r["nll"]["mean"].as_f64().unwrap().is_finite());
     let svg = std::fs::read_to_string(&fig).unwrap();
     assert!(svg.starts_with("<svg") && svg.contains("test sample"));

@@ -17,7 +17,11 @@ where
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => Path::new("."),
     };
-    let mut tmp = tempfile::Builder::new()
+    let mut builder = tempfile::Builder::new();
+    // Like `File::create`: 0o666 restricted by the umask (tempfile's default is 0o600).
+    #[cfg(unix)]
+    builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
+    let mut tmp = builder
         .prefix(&format!(
             ".{}.",
             path.file_name().and_then(|n| n.to_str()).unwrap_or("out")
@@ -60,5 +64,20 @@ mod tests {
         );
         write_bytes_atomic(&path, b"ok").unwrap();
         assert_eq!(std::fs::read(&path).unwrap(), b"ok");
+    }
+
+    /// Output files get the same mode as `File::create` gives (0o666 less the umask), not
+    /// the temporary file's private 0o600.
+    #[cfg(unix)]
+    #[test]
+    fn output_mode_follows_the_umask_like_file_create() {
+        use std::os::unix::fs::PermissionsExt;
+        let dir = tempfile::tempdir().unwrap();
+        let plain = dir.path().join("plain.bin");
+        std::fs::File::create(&plain).unwrap();
+        let atomic = dir.path().join("atomic.bin");
+        write_bytes_atomic(&atomic, b"x").unwrap();
+        let mode = |p: &Path| std::fs::metadata(p).unwrap().permissions().mode() & 0o777;
+        assert_eq!(mode(&atomic), mode(&plain));
     }
 }

@@ -42,7 +42,10 @@ fn setup() -> (Elbo, Vec<f64>, ModelConfig, Params, Vec<f64>) {
     let params = Params::init(&config, &ParamInit::default(), 1);
     let theta = params.unconstrained(&config);
     let mut opts = ElboOptions::paper(512);
-    opts.windows_per_task = 8;
+    opts.windows_per_task = std::env::var("WPT")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(8);
     let elbo = Elbo::new(config.clone(), data, opts).unwrap();
     (elbo, theta, config, params, u)
 }
@@ -125,6 +128,22 @@ fn bench(c: &mut Criterion) {
         );
     }
     let zero = vec![0.0; 12];
+    let reps = 100;
+    let cpu0 = cpu_seconds();
+    let t0 = Instant::now();
+    for i in 0..reps {
+        black_box(predict(&config, &params, &u, &zero, &zero, 30, i).unwrap());
+    }
+    let wall = t0.elapsed().as_secs_f64() / reps as f64;
+    if let Some(cpu) = cpu_seconds().zip(cpu0).map(|(a, b)| (a - b) / reps as f64) {
+        println!(
+            "prediction (470 steps × 30 particles, one thread): {:.2} ms wall, {:.2} ms CPU \
+             (authors: 152 ms, {:.0}× faster)",
+            1e3 * wall,
+            1e3 * cpu,
+            0.152 / cpu
+        );
+    }
     let mut g = c.benchmark_group("predict");
     g.bench_function("len470_p30", |b| {
         b.iter(|| predict(&config, &params, black_box(&u), &zero, &zero, 30, 3).unwrap())

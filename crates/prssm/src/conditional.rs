@@ -221,6 +221,7 @@ pub struct ConditionalWorkspace {
     cx: Vec<f64>,
     zc: Vec<f64>,
     rowsum: Vec<f64>,
+    input_group: usize,
     /// Means `μ`, column-major `D_x × N`.
     pub mean: Vec<f64>,
     /// Variances `σ²`, column-major `D_x × N`.
@@ -286,9 +287,17 @@ impl ConditionalWorkspace {
             cx: vec![0.0; m * d],
             zc: vec![0.0; d * n],
             rowsum: vec![0.0; m],
+            input_group: 1,
             mean: vec![0.0; dx * n],
             var: vec![0.0; dx * n],
         }
+    }
+
+    /// Declares that consecutive groups of `group` points share the input part `u` of
+    /// [`Self::input`] (rows `D_x..D`), e.g. the particles of one window; the shared part of
+    /// the kernel distances is then computed once per group. Default 1 (nothing shared).
+    pub(crate) fn set_input_group(&mut self, group: usize) {
+        self.input_group = group.max(1);
     }
 
     /// Capacity in points.
@@ -310,15 +319,17 @@ impl ConditionalWorkspace {
         debug_assert!(n <= self.cap);
         let t = split_tape(post, self.cap, n, tape);
         kernel::scale_points(&self.input[..d * n], &post.inv_len, t.xs);
-        kernel::cross_cov(
+        kernel::cross_cov_grouped(
             post.kind,
             post.variance,
             post.tau_jitter,
             &post.zt,
             t.xs,
             d,
+            (dx, self.input_group.max(1)),
             t.k,
             t.kd,
+            &mut self.rowsum,
         );
         gemm(
             view_mut(t.w, m, n),

@@ -216,29 +216,36 @@ pub struct Elbo {
     data: TrainingData,
     options: ElboOptions,
     tape_budget_bytes: usize,
-    tapes: TapePool,
+    scratch: ScratchPool,
 }
 
-/// Tape buffers kept between evaluations (fresh pages cost more than the arithmetic); the
-/// contents are always overwritten before they are read.
+/// Per-chunk buffers kept between evaluations (fresh pages cost more than the arithmetic);
+/// every value is written before it is read.
 #[derive(Debug, Default)]
-struct TapePool(std::sync::Mutex<Vec<Vec<f64>>>);
+struct ScratchPool(std::sync::Mutex<Vec<ChunkScratch>>);
 
-impl Clone for TapePool {
+#[derive(Debug, Default)]
+struct ChunkScratch {
+    tape: Vec<f64>,
+    xs: Vec<f64>,
+    eps: Vec<f64>,
+    sds: Vec<f64>,
+    ws: Option<ConditionalWorkspace>,
+}
+
+impl Clone for ScratchPool {
     fn clone(&self) -> Self {
         Self::default()
     }
 }
 
-impl TapePool {
-    fn take(&self, len: usize) -> Vec<f64> {
+impl ScratchPool {
+    fn take(&self) -> ChunkScratch {
         let mut pool = self.0.lock().unwrap_or_else(|e| e.into_inner());
-        let mut v = pool.pop().unwrap_or_default();
-        v.resize(len, 0.0);
-        v
+        pool.pop().unwrap_or_default()
     }
 
-    fn put(&self, v: Vec<f64>) {
+    fn put(&self, v: ChunkScratch) {
         self.0.lock().unwrap_or_else(|e| e.into_inner()).push(v);
     }
 }
@@ -309,7 +316,7 @@ impl Elbo {
             data,
             options,
             tape_budget_bytes: TAPE_BUDGET_BYTES,
-            tapes: TapePool::default(),
+            scratch: ScratchPool::default(),
         })
     }
 
@@ -568,8 +575,11 @@ impl Elbo {
             .map(|&i| (self.options.burn_in_fraction * batch[i].len as f64).floor() as usize)
             .collect();
         let step = dx * n;
-        let mut xs = vec![0.0; t_max * step];
-        let mut eps = vec![0.0; t_max.saturating_sub(1) * step];
+        let mut scratch = self.scratch.take();
+        let mut xs = std::mem::take(&mut scratch.xs);
+        xs.resize(t_max * step, 0.0);
+        let mut eps = std::mem::take(&mut scratch.eps);
+        eps.resize(t_max.saturating_sub(1) * step, 0.0);
         let mut eps0 = vec![0.0; step];
         for (k, &bi) in chunk.iter().enumerate() {
             let mut rng = ChaCha8Rng::seed_from_u64(seed);
@@ -600,7 +610,11 @@ impl Elbo {
                 }
             }
         }
-        let mut ws = ConditionalWorkspace::new(post, n);
+        let mut ws = match scratch.ws.take() {
+            Some(ws) if ws.capacity() == n => ws,
+            _ => ConditionalWorkspace::new(post, n),
+        };
+        ws.set_input_group(np);
         let vx = &p.process_noise_var;
         let vy = &p.obs_noise_var;
         let jit = cfg.transition_jitter;
@@ -651,9 +665,11 @@ impl Elbo {
         let tape_step = conditional::tape_len(post, n);
         let n_steps = t_max.saturating_sub(1);
         let seg = (self.tape_budget_bytes / (8 * tape_step.max(1))).clamp(1, n_steps.max(1));
-        let mut tape = self.tapes.take(seg.min(n_steps) * tape_step);
+        let mut tape = std::mem::take(&mut scratch.tape);
+        tape.resize(seg.min(n_steps) * tape_step, 0.0);
         // Standard deviations √(σ² + σ_x² + δ) of every step, `(T − 1) × D_x × N`.
-        let mut sds = vec![0.0; n_steps * step];
+        let mut sds = std::mem::take(&mut scratch.sds);
+        sds.resize(n_steps * step, 0.0);
         let propagate = |ws: &mut ConditionalWorkspace,
                          tape: &mut [f64],
                          xs: &mut [f64],
@@ -754,7 +770,13 @@ impl Elbo {
                 }
             }
         }
-        self.tapes.put(tape);
+        self.scratch.put(ChunkScratch {
+            tape,
+            xs,
+            eps,
+            sds,
+            ws: Some(ws),
+        });
         ChunkOut {
             nll,
             cond,
@@ -863,7 +885,7 @@ mod tests {
             let e = elbo.clone().with_tape_budget(steps * step_bytes);
             assert_eq!(run(&e), full, "{steps} steps per segment");
         }
-        // A repeated evaluation reuses the pooled tapes.
+        // A repeated evaluation reuses the pooled buffers.
         assert_eq!(run(&elbo), full);
     }
 }

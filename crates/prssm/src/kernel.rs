@@ -128,29 +128,90 @@ pub fn cross_cov(
     kd: &mut [f64],
 ) {
     let m_n = zt.len() / d;
-    let (wide, narrow) = (m_n / 32 * 32, m_n / 8 * 8);
     for ((kc, kdc), x) in k
         .chunks_exact_mut(m_n)
         .zip(kd.chunks_exact_mut(m_n))
         .zip(xs.chunks_exact(d))
     {
-        for m0 in (0..wide).step_by(32) {
-            kc[m0..m0 + 32].copy_from_slice(&tau_block::<32>(zt, m_n, m0, x));
-        }
-        for m0 in (wide..narrow).step_by(8) {
-            kc[m0..m0 + 8].copy_from_slice(&tau_block::<8>(zt, m_n, m0, x));
-        }
-        for m in narrow..m_n {
-            kc[m] = tau_block::<1>(zt, m_n, m, x)[0];
-        }
+        sq_dist(zt, m_n, 0, x, None, kc);
         apply_shape(kind, variance, matern_tau_jitter, kc, kdc);
     }
 }
 
-/// `τ(z_m, x)` for `m = m0..m0 + W` (independent SIMD accumulators for wide `W`).
+/// [`cross_cov`] for points in consecutive groups of `group` that share their coordinates
+/// `shared_from..D` (particles of one window share the input `u`): the shared part of `τ`
+/// is computed once per group into `tau_shared` (`M`). Same results as [`cross_cov`] up to
+/// the order of the sum.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn cross_cov_grouped(
+    kind: KernelKind,
+    variance: f64,
+    matern_tau_jitter: f64,
+    zt: &[f64],
+    xs: &[f64],
+    d: usize,
+    (shared_from, group): (usize, usize),
+    k: &mut [f64],
+    kd: &mut [f64],
+    tau_shared: &mut [f64],
+) {
+    let m_n = zt.len() / d;
+    let tau_shared = &mut tau_shared[..m_n];
+    for ((kg, kdg), xg) in k
+        .chunks_mut(m_n * group)
+        .zip(kd.chunks_mut(m_n * group))
+        .zip(xs.chunks(d * group))
+    {
+        sq_dist(zt, m_n, shared_from, &xg[shared_from..d], None, tau_shared);
+        for ((kc, kdc), x) in kg
+            .chunks_exact_mut(m_n)
+            .zip(kdg.chunks_exact_mut(m_n))
+            .zip(xg.chunks_exact(d))
+        {
+            sq_dist(zt, m_n, 0, &x[..shared_from], Some(tau_shared), kc);
+            apply_shape(kind, variance, matern_tau_jitter, kc, kdc);
+        }
+    }
+}
+
+/// `out[m] = init[m] + Σ_j (z̃_{m, j0+j} − x_j)²` for all `M` inducing points, in SIMD
+/// register blocks (`zt` dimension-major with stride `m_n`).
 #[inline(always)]
-fn tau_block<const W: usize>(zt: &[f64], m_n: usize, m0: usize, x: &[f64]) -> [f64; W] {
+fn sq_dist(zt: &[f64], m_n: usize, j0: usize, x: &[f64], init: Option<&[f64]>, out: &mut [f64]) {
+    let zt = &zt[j0 * m_n..];
+    let (wide, narrow) = (m_n / 32 * 32, m_n / 8 * 8);
+    for m0 in (0..wide).step_by(32) {
+        out[m0..m0 + 32].copy_from_slice(&tau_block::<32>(zt, m_n, m0, x, init));
+    }
+    for m0 in (wide..narrow).step_by(8) {
+        out[m0..m0 + 8].copy_from_slice(&tau_block::<8>(zt, m_n, m0, x, init));
+    }
+    if narrow < m_n {
+        if m_n >= 8 {
+            // The last 8 (overlapping entries get identical values).
+            let b = tau_block::<8>(zt, m_n, m_n - 8, x, init);
+            out[m_n - 8..m_n].copy_from_slice(&b);
+        } else {
+            for m in narrow..m_n {
+                out[m] = tau_block::<1>(zt, m_n, m, x, init)[0];
+            }
+        }
+    }
+}
+
+/// `τ` for `m = m0..m0 + W` (independent SIMD accumulators for wide `W`).
+#[inline(always)]
+fn tau_block<const W: usize>(
+    zt: &[f64],
+    m_n: usize,
+    m0: usize,
+    x: &[f64],
+    init: Option<&[f64]>,
+) -> [f64; W] {
     let mut acc = [0.0; W];
+    if let Some(init) = init {
+        acc.copy_from_slice(&init[m0..m0 + W]);
+    }
     for (j, &xj) in x.iter().enumerate() {
         let z = &zt[j * m_n + m0..][..W];
         for l in 0..W {

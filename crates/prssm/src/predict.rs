@@ -59,7 +59,9 @@ impl StepPredictor {
             return Err(ObjectiveError::Shape("particles must be ≥ 1".into()));
         }
         let post = Posterior::new(config, params)?;
-        let ws = ConditionalWorkspace::new(&post, particles);
+        let mut ws = ConditionalWorkspace::new(&post, particles);
+        // All particles share the input of a step.
+        ws.set_input_group(particles);
         Ok(Self {
             post,
             ws,

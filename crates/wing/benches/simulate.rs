@@ -10,15 +10,23 @@ use rand_chacha::ChaCha8Rng;
 
 fn bench_simulate(c: &mut Criterion) {
     let gen_cfg = GeneratorConfig::default();
-    let spec = gen_cfg.generate_one(0, Family::FigureEight).expect("trajectory");
+    let spec = gen_cfg
+        .generate_one(0, Family::FigureEight)
+        .expect("trajectory");
     let mut group = c.benchmark_group("simulate_trajectory");
     for fidelity in [Fidelity::L0, Fidelity::L1] {
-        let cfg = VirtualWingConfig { fidelity, ..VirtualWingConfig::default() };
+        let cfg = VirtualWingConfig {
+            fidelity,
+            ..VirtualWingConfig::default()
+        };
         let mut wing = VirtualWing::new(&cfg).expect("wing");
         let mut rng = ChaCha8Rng::seed_from_u64(1);
         let errors = DatasetSensorErrors::draw(&cfg.sensor, &mut rng);
         group.bench_function(BenchmarkId::from_parameter(format!("{fidelity:?}")), |b| {
-            b.iter(|| wing.simulate(&spec, &gen_cfg.sampling, 0, &errors, &mut rng).expect("simulate"))
+            b.iter(|| {
+                wing.simulate(&spec, &gen_cfg.sampling, 0, &errors, &mut rng)
+                    .expect("simulate")
+            })
         });
     }
     group.finish();

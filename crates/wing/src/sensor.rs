@@ -8,7 +8,8 @@
 //!    dataset, |ε_s| = `static_residual_frac`;
 //! 2. residual of the inertial subtraction: ε_i·y_inertial (rigid plate, ε_i per dataset,
 //!    |ε_i| = `inertial_residual_frac`);
-//! 3. cross-axis coupling y ← (I + E)y, E_ij ~ N(0, σ_E²) fixed per dataset;
+//! 3. cross-axis coupling y/FS ← (I + E)(y/FS) on full-scale-normalized signals,
+//!    E_ij ~ N(0, σ_E²) fixed per dataset;
 //! 4. per-trajectory bias N(0, (b·FS)²) plus a Gaussian random walk reaching a standard
 //!    deviation d·FS after 20 s (FS = 12 N, 120 N·mm);
 //! 5. servo vibration: one sinusoid per channel at a random 5–30 Hz, amplitude a·RMS(y);
@@ -250,17 +251,6 @@ pub fn measure(
 ) -> Vec<[f64; 5]> {
     let n = raw.len();
     let dt = 1.0 / raw_rate_hz;
-    for ((y, ys), yi) in raw.iter_mut().zip(static_loads).zip(inertial_loads) {
-        for c in 0..5 {
-            y[c] += errors.static_residual * ys[c] + errors.inertial_residual * yi[c];
-        }
-        if cfg.cross_axis {
-            let y0 = *y;
-            for (c, row) in errors.cross_axis.iter().enumerate() {
-                y[c] += row.iter().zip(&y0).map(|(e, v)| e * v).sum::<f64>();
-            }
-        }
-    }
     let fs = |c: usize| {
         if c < 2 {
             cfg.force_full_scale_n
@@ -268,6 +258,24 @@ pub fn measure(
             cfg.moment_full_scale_n_mm
         }
     };
+    for ((y, ys), yi) in raw.iter_mut().zip(static_loads).zip(inertial_loads) {
+        for c in 0..5 {
+            y[c] += errors.static_residual * ys[c] + errors.inertial_residual * yi[c];
+        }
+        if cfg.cross_axis {
+            // E acts on full-scale-normalized signals (calibration-matrix error).
+            let y0 = *y;
+            for (c, row) in errors.cross_axis.iter().enumerate() {
+                let coupled: f64 = row
+                    .iter()
+                    .zip(&y0)
+                    .enumerate()
+                    .map(|(j, (e, v))| e * v / fs(j))
+                    .sum();
+                y[c] += fs(c) * coupled;
+            }
+        }
+    }
     let std = Normal::new(0.0, 1.0).expect("unit normal");
     let mut column = vec![0.0; n];
     let mut work = Vec::with_capacity(n + 512);

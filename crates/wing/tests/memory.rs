@@ -68,7 +68,18 @@ fn regressors(inputs: &[[f64; 7]], k: usize, history: bool, out: &mut Vec<f64>) 
         let u = &inputs[k - lag];
         out.extend_from_slice(&published_features(u));
         let [aoa, v, a_x, a_y, _, alpha_dot, _] = *u;
-        out.extend([v, aoa * v, aoa * aoa * v, aoa * aoa * aoa * v, alpha_dot, a_x, a_y].map(|g| speed * g));
+        out.extend(
+            [
+                v,
+                aoa * v,
+                aoa * aoa * v,
+                aoa * aoa * aoa * v,
+                alpha_dot,
+                a_x,
+                a_y,
+            ]
+            .map(|g| speed * g),
+        );
     }
 }
 
@@ -104,12 +115,12 @@ fn fit(ds: &Dataset, history: bool) -> Fit {
     let mut targets = Vec::new();
     for t in train {
         let y = t.outputs.as_ref().unwrap();
-        for k in SKIP..t.inputs.len() {
+        for (k, yk) in y.iter().enumerate().skip(SKIP) {
             regressors(&t.inputs, k, history, &mut row);
             rows.extend_from_slice(&row);
             targets.push(
                 (0..5)
-                    .map(|c| (y[k][c] - mean[c]) / sd[c])
+                    .map(|c| (yk[c] - mean[c]) / sd[c])
                     .collect::<Vec<_>>(),
             );
         }
@@ -145,11 +156,11 @@ fn fit(ds: &Dataset, history: bool) -> Fit {
     for t in &ds.trajectories[ds.n_train..] {
         let y = t.outputs.as_ref().unwrap();
         let mut res = Vec::new();
-        for k in SKIP..t.inputs.len() {
+        for (k, yk) in y.iter().enumerate().skip(SKIP) {
             regressors(&t.inputs, k, history, &mut row);
             for c in 0..5 {
                 let pred: f64 = (0..p).map(|j| row[j] / scale[j] * beta[(j, c)]).sum();
-                let e = (y[k][c] - mean[c]) / sd[c] - pred;
+                let e = (yk[c] - mean[c]) / sd[c] - pred;
                 sse += e * e;
                 ch[c] += e * e;
                 count += 1.0;

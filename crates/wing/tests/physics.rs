@@ -429,8 +429,15 @@ fn hovering_sanity() {
         );
         // L1 sits below QS at mid-stroke: at r_cp a ±80° half-stroke is only ≈ 8 chords of
         // travel, so the Wagner and LEV lags and the inflow have not settled.
-        let band = if fidelity == Fidelity::L0 { 2.3..=2.6 } else { 1.5..=2.6 };
-        assert!(band.contains(&cn_mid), "{fidelity:?}: mid-stroke C_N = {cn_mid}");
+        let band = if fidelity == Fidelity::L0 {
+            2.3..=2.6
+        } else {
+            1.5..=2.6
+        };
+        assert!(
+            band.contains(&cn_mid),
+            "{fidelity:?}: mid-stroke C_N = {cn_mid}"
+        );
     }
 }
 
@@ -441,7 +448,11 @@ fn default_strip_count_is_converged() {
     let dt = 0.004;
     let states = generated_states(dt, 3000);
     let run = |n_strips| {
-        let cfg = VirtualWingConfig { fidelity: Fidelity::L1, n_strips, ..VirtualWingConfig::default() };
+        let cfg = VirtualWingConfig {
+            fidelity: Fidelity::L1,
+            n_strips,
+            ..VirtualWingConfig::default()
+        };
         let mut w = VirtualWing::new(&cfg).unwrap();
         let mut y = vec![[0.0; 5]; states.len()];
         w.aero_loads_into(&states, dt, &mut y);
@@ -451,7 +462,11 @@ fn default_strip_count_is_converged() {
     let (a, b) = (run(8), run(40));
     for c in 0..5 {
         let peak = b.iter().map(|y| y[c].abs()).fold(0.0, f64::max);
-        let err = a.iter().zip(&b).map(|(x, y)| (x[c] - y[c]).abs()).fold(0.0, f64::max);
+        let err = a
+            .iter()
+            .zip(&b)
+            .map(|(x, y)| (x[c] - y[c]).abs())
+            .fold(0.0, f64::max);
         assert!(err <= 5e-3 * peak, "channel {c}: {err} vs peak {peak}");
     }
 }

@@ -1,6 +1,6 @@
 //! TEMPORARY diagnostics (to be deleted).
-use std::f64::consts::PI;
 use flapssm_wing::vortex::{Ldvm, LdvmParams, PlateState, VortexKind};
+use std::f64::consts::PI;
 
 fn eldredge(t: f64) -> (f64, f64) {
     let (amp, k, sigma) = (PI / 4.0, 0.4, 0.8);
@@ -14,20 +14,40 @@ fn eldredge(t: f64) -> (f64, f64) {
 
 #[test]
 fn diag_eldredge() {
-    let core: f64 = std::env::var("CORE").ok().and_then(|s| s.parse().ok()).unwrap_or(0.02);
-    let nch: usize = std::env::var("NCH").ok().and_then(|s| s.parse().ok()).unwrap_or(24);
+    let core: f64 = std::env::var("CORE")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(0.02);
+    let nch: usize = std::env::var("NCH")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(24);
     let p = LdvmParams {
-        chord_m: 1.0, u_ref_m_s: 1.0, rho_kg_m3: 1.0, pivot_frac: 0.0,
-        lesp_crit: Some(0.11), lev_decay_chords: None, tev_decay_chords: None,
-        far_field_chords: None, max_vortices: 400, core_radius_frac: core, n_chord: nch,
+        chord_m: 1.0,
+        u_ref_m_s: 1.0,
+        rho_kg_m3: 1.0,
+        pivot_frac: 0.0,
+        lesp_crit: Some(0.11),
+        lev_decay_chords: None,
+        tev_decay_chords: None,
+        far_field_chords: None,
+        max_vortices: 400,
+        core_radius_frac: core,
+        n_chord: nch,
         ..LdvmParams::default()
     };
     let dt = 0.015;
     let mut l = Ldvm::new(p).unwrap();
+    let mut i_prev = [0.0f64; 2];
     for k in 0..((5.0 / dt) as usize) {
         let t = k as f64 * dt;
         let (a, ad) = eldredge(t);
-        let plate = PlateState { pivot_m: [-t, 0.0], pivot_vel_m_s: [-1.0, 0.0], angle_rad: -a, angle_rate_rad_s: -ad };
+        let plate = PlateState {
+            pivot_m: [-t, 0.0],
+            pivot_vel_m_s: [-1.0, 0.0],
+            angle_rad: -a,
+            angle_rate_rad_s: -ad,
+        };
         let ld = l.step(&plate, dt).unwrap();
         let d = *l.diagnostics();
         let th = -a;
@@ -35,6 +55,19 @@ fn diag_eldredge() {
         let (tx, tz, nx, nz) = (c, s, -s, c);
         let cl = ld.normal_n_m * nz + ld.chord_n_m * tz;
         let w = l.wake();
+        let le = [plate.pivot_m[0], plate.pivot_m[1]];
+        let bb = d.fourier_m_s;
+        let gb = -PI * (bb[0] + 0.5 * bb[1]);
+        let mb = -PI * (0.25 * bb[0] + 0.25 * bb[1] - 0.125 * bb[2]);
+        let mut imp = [gb * le[1] + mb * tz, -gb * le[0] - mb * tx];
+        for i in 0..w.len() {
+            imp[0] += w.gamma_m2_s()[i] * w.z_m()[i];
+            imp[1] -= w.gamma_m2_s()[i] * w.x_m()[i];
+        }
+        let f = [-(imp[0] - i_prev[0]) / dt, -(imp[1] - i_prev[1]) / dt];
+        i_prev = imp;
+        let cn_imp = 2.0 * (f[0] * nx + f[1] * nz);
+        let cl_imp = 2.0 * f[1];
         let (mut nl, mut gl, mut dmin, mut xcen, mut gsum) = (0, 0.0, f64::INFINITY, 0.0, 0.0);
         for i in 0..w.len() {
             if w.kinds()[i] == VortexKind::Lev {
@@ -43,14 +76,37 @@ fn diag_eldredge() {
                 let (dx, dz) = (w.x_m()[i] - plate.pivot_m[0], w.z_m()[i] - plate.pivot_m[1]);
                 let xn = dx * nx + dz * nz;
                 let xt = dx * tx + dz * tz;
-                if xt < 1.2 { dmin = dmin.min(xn); }
+                if xt < 1.2 {
+                    dmin = dmin.min(xn);
+                }
                 xcen += xt * w.gamma_m2_s()[i];
                 gsum += w.gamma_m2_s()[i];
             }
         }
-        if k % 5 == 0 {
-            println!("t {t:.3} a {:5.1} CL {cl:7.3} CN [{:7.3} {:7.3} {:7.3}] A0 {:6.3} A0u {:6.3} nlev {nl} GL {gl:7.3} dmin {dmin:6.3} xc {:6.3}",
-                a.to_degrees(), 2.0*d.normal_terms_n_m[0], 2.0*d.normal_terms_n_m[1], 2.0*d.normal_terms_n_m[2], d.lesp, d.lesp_unshed, if gsum != 0.0 { xcen / gsum } else { 0.0 });
+        if std::env::var("DUMP").is_ok() && (k == 80 || k == 133) {
+            for i in 0..w.len() {
+                let (dx, dz) = (w.x_m()[i] - plate.pivot_m[0], w.z_m()[i] - plate.pivot_m[1]);
+                println!(
+                    "  V {:?} xt {:7.4} xn {:7.4} g {:7.4}",
+                    w.kinds()[i],
+                    dx * tx + dz * tz,
+                    dx * nx + dz * nz,
+                    w.gamma_m2_s()[i]
+                );
+            }
+        }
+        if k % 5 == 0 || std::env::var("ALL").is_ok() {
+            println!(
+                "CNimp {cn_imp:7.3} CLimp {cl_imp:7.3} CN {:7.3} t {t:.3} a {:5.1} CL {cl:7.3} CN [{:7.3} {:7.3} {:7.3}] A0 {:6.3} A0u {:6.3} nlev {nl} GL {gl:7.3} dmin {dmin:6.3} xc {:6.3}",
+                2.0 * ld.normal_n_m,
+                a.to_degrees(),
+                2.0 * d.normal_terms_n_m[0],
+                2.0 * d.normal_terms_n_m[1],
+                2.0 * d.normal_terms_n_m[2],
+                d.lesp,
+                d.lesp_unshed,
+                if gsum != 0.0 { xcen / gsum } else { 0.0 }
+            );
         }
     }
 }

@@ -55,12 +55,20 @@ pub fn run(args: SimulateArgs) -> anyhow::Result<()> {
     let cfg = SimulationConfig {
         wing: VirtualWingConfig {
             fidelity,
-            sensor: if args.noise_free { SensorConfig::noise_free() } else { SensorConfig::default() },
+            sensor: if args.noise_free {
+                SensorConfig::noise_free()
+            } else {
+                SensorConfig::default()
+            },
             ..VirtualWingConfig::default()
         },
         trajectories,
     };
-    let bar = if args.quiet { ProgressBar::hidden() } else { ProgressBar::new(args.n as u64) };
+    let bar = if args.quiet {
+        ProgressBar::hidden()
+    } else {
+        ProgressBar::new(args.n as u64)
+    };
     bar.set_style(
         ProgressStyle::with_template("{bar:40} {pos}/{len} trajectories, {elapsed} (eta {eta})")
             .context("progress bar template")?,
@@ -68,8 +76,11 @@ pub fn run(args: SimulateArgs) -> anyhow::Result<()> {
     let ds = simulate_dataset(&cfg, &|| bar.inc(1)).context("simulating the wing")?;
     bar.finish_and_clear();
     let sim_s = start.elapsed().as_secs_f64();
-    ds.save(&args.out).with_context(|| format!("writing dataset {}", args.out.display()))?;
-    let re = ds.meta.settings["mean_reynolds_number"].as_f64().unwrap_or(f64::NAN);
+    ds.save(&args.out)
+        .with_context(|| format!("writing dataset {}", args.out.display()))?;
+    let re = ds.meta.settings["mean_reynolds_number"]
+        .as_f64()
+        .unwrap_or(f64::NAN);
     println!(
         "wrote {}: {} trajectories ({} train) × {} samples, fidelity {:?}, {}, seed {}, mean Re {:.0}; \
          simulated in {:.2} s, total {:.2} s",
@@ -78,7 +89,11 @@ pub fn run(args: SimulateArgs) -> anyhow::Result<()> {
         ds.n_train,
         cfg.trajectories.sampling.n_samples,
         fidelity,
-        if args.noise_free { "noise-free" } else { "with sensor model" },
+        if args.noise_free {
+            "noise-free"
+        } else {
+            "with sensor model"
+        },
         args.seed,
         re,
         sim_s,

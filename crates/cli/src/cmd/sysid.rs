@@ -7,6 +7,7 @@ use anyhow::Context;
 use clap::Args;
 use flapssm_analysis::sysid::{IoRecord, SeedRun, SysidSpec, run as run_protocol};
 use flapssm_data::table::Column;
+use flapssm_prssm::train::LrSchedule;
 
 /// Fit a PR-SSM on the first part of a record, simulate the rest open loop, report test
 /// RMSE (raw units) and NLL per seed and mean ± std.
@@ -29,6 +30,12 @@ pub struct SysidArgs {
     /// Optimizer steps per fit.
     #[arg(long, default_value_t = 3000)]
     iterations: u64,
+    /// Adam learning rate (protocol: 0.1).
+    #[arg(long, default_value_t = 0.1)]
+    lr: f64,
+    /// Cosine-anneal the learning rate to `lr · F` at the last step (default: constant).
+    #[arg(long, value_name = "F")]
+    cosine: Option<f64>,
     /// Also score the last parameters of each fit (not only the selected best), for diagnosis.
     #[arg(long)]
     diagnose_last: bool,
@@ -62,12 +69,16 @@ fn print_run(r: &SeedRun) {
 pub fn run(args: SysidArgs) -> anyhow::Result<()> {
     let record = IoRecord::read(&args.file, &args.inputs, &args.outputs)
         .with_context(|| format!("reading {}", args.file.display()))?;
-    let spec = SysidSpec {
+    let mut spec = SysidSpec {
         split: args.split,
         seeds: args.seeds,
         ..SysidSpec::reference(args.inputs.len(), args.outputs.len())
     }
     .with_iterations(args.iterations);
+    spec.fit.train.lr = args.lr;
+    if let Some(f) = args.cosine {
+        spec.fit.train.schedule = LrSchedule::Cosine { final_factor: f };
+    }
     let json = args.json;
     if !json {
         println!(

@@ -74,9 +74,11 @@ pub struct SectionLoads {
     pub moment_n: f64,
 }
 
-impl SectionLoads {
+impl std::ops::Add for SectionLoads {
+    type Output = SectionLoads;
+
     /// Component-wise sum.
-    pub fn add(self, other: SectionLoads) -> SectionLoads {
+    fn add(self, other: SectionLoads) -> SectionLoads {
         SectionLoads {
             normal_n_m: self.normal_n_m + other.normal_n_m,
             chordwise_n_m: self.chordwise_n_m + other.chordwise_n_m,

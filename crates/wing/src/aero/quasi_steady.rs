@@ -155,7 +155,11 @@ pub fn added_mass(geom: &SectionGeometry, kin: &SectionKinematics) -> SectionLoa
 }
 
 /// The added-mass loads that `params` switch on (zero when `added_mass` is off).
-pub fn added_mass_loads(geom: &SectionGeometry, params: &QuasiSteadyParams, kin: &SectionKinematics) -> SectionLoads {
+pub fn added_mass_loads(
+    geom: &SectionGeometry,
+    params: &QuasiSteadyParams,
+    kin: &SectionKinematics,
+) -> SectionLoads {
     if !params.added_mass {
         return SectionLoads::default();
     }
@@ -225,7 +229,12 @@ impl QuasiSteadySection {
     /// Loads for the given kinematics (no memory).
     pub fn loads(&self, kin: &SectionKinematics) -> SectionLoads {
         let (n, t) = (kin.normal_velocity_m_s, kin.chord_velocity_m_s);
-        let coeffs = translational_coefficients(n, t, self.params.translational_scale, self.params.skin_friction);
+        let coeffs = translational_coefficients(
+            n,
+            t,
+            self.params.translational_scale,
+            self.params.skin_friction,
+        );
         let circ = circulatory_loads(
             &self.geom,
             &self.params,
@@ -234,7 +243,7 @@ impl QuasiSteadySection {
             kin.rotation_rate_rad_s,
             &coeffs,
         );
-        circ.add(added_mass_loads(&self.geom, &self.params, kin))
+        circ + added_mass_loads(&self.geom, &self.params, kin)
     }
 }
 

@@ -165,8 +165,16 @@ impl FohStep {
         let em1 = (-bd).exp_m1();
         let e1 = -em1 / b;
         // R by series when bΔ is small.
-        let ramp = if bd < 1e-4 { delta * (0.5 - bd / 6.0) } else { (delta - e1) / bd };
-        Self { decay: 1.0 + em1, e1, ramp }
+        let ramp = if bd < 1e-4 {
+            delta * (0.5 - bd / 6.0)
+        } else {
+            (delta - e1) / bd
+        };
+        Self {
+            decay: 1.0 + em1,
+            e1,
+            ramp,
+        }
     }
 
     fn apply(&self, x: f64, u0: f64, u1: f64) -> f64 {
@@ -209,8 +217,12 @@ impl SectionModel for UnsteadySection {
 
         // Attached (potential) share of the translational force, w_att = cos²α_g; the rest is
         // the LEV share.
-        let mut coeffs =
-            translational_coefficients(n_rel, t_rel, p.quasi_steady.translational_scale, p.quasi_steady.skin_friction);
+        let mut coeffs = translational_coefficients(
+            n_rel,
+            t_rel,
+            p.quasi_steady.translational_scale,
+            p.quasi_steady.skin_friction,
+        );
         let cos2 = if speed > 0.0 {
             t_rel * t_rel / (speed * speed)
         } else {
@@ -274,14 +286,13 @@ impl SectionModel for UnsteadySection {
             normal_n_m: rho * speed * g[0],
             chordwise_n_m: rho * speed * g[1],
             moment_n: rho * speed * g[2],
-        }
-        .add(lev);
+        } + lev;
         self.g_prev = [
             self.g_prev[0] + lev.normal_n_m * inv,
             self.g_prev[1],
             self.g_prev[2],
         ];
-        circ.add(added_mass_loads(&self.geom, &p.quasi_steady, kin))
+        circ + added_mass_loads(&self.geom, &p.quasi_steady, kin)
     }
 }
 

@@ -546,10 +546,7 @@ impl BoundSheet<'_> {
         }
         // multiply by −i: (fr + i fi)(−i) = fi − i fr  →  u = fi, w = fr
         let (u, w) = (fi, fr);
-        (
-            u * self.t[0] + w * self.n[0],
-            u * self.t[1] + w * self.n[1],
-        )
+        (u * self.t[0] + w * self.n[0], u * self.t[1] + w * self.n[1])
     }
 }
 
@@ -581,6 +578,7 @@ fn first_position(edge: [f64; 2], v_edge: [f64; 2], t: [f64; 2], dt_s: f64, c: f
 
 #[cfg(test)]
 mod tests {
+    use super::super::wake::induced_at;
     use super::*;
 
     /// The load weights equal the chord integrals of the pressure jump, by quadrature.
@@ -613,6 +611,55 @@ mod tests {
                 "moment weight {k}: {} vs {}",
                 m / PI,
                 MF[k]
+            );
+        }
+    }
+
+    /// The closed-form sheet velocity equals the Biot–Savart sum over a fine discretisation of
+    /// γ, off the plate (tilted plate, points above, below, ahead and behind).
+    #[test]
+    fn sheet_velocity_matches_biot_savart_quadrature() {
+        let c = 0.7;
+        let b = [0.3, -0.2, 0.1, 0.05, -0.02];
+        let th0: f64 = 0.4;
+        let (t, n) = ([th0.cos(), th0.sin()], [-th0.sin(), th0.cos()]);
+        let le = [0.2, -0.1];
+        let sheet = BoundSheet {
+            le,
+            t,
+            n,
+            c,
+            eps4: 0.0,
+            b: &b,
+        };
+        let m = 400_000;
+        let (mut xs, mut zs, mut gs) = (vec![], vec![], vec![]);
+        for i in 0..m {
+            let th = (i as f64 + 0.5) * PI / m as f64;
+            let x = 0.5 * c * (1.0 - th.cos());
+            // γ dξ = c [B0 (1 + cos θ) + Σ B_n sin nθ sin θ] dθ, clockwise
+            let mut g = b[0] * (1.0 + th.cos());
+            for (k, bk) in b.iter().enumerate().skip(1) {
+                g += bk * (k as f64 * th).sin() * th.sin();
+            }
+            xs.push(le[0] + x * t[0]);
+            zs.push(le[1] + x * t[1]);
+            gs.push(-c * g * PI / m as f64);
+        }
+        for (xp, zp) in [
+            (0.3, 0.2),
+            (0.5, -0.15),
+            (-0.1, 0.05),
+            (1.2, 0.1),
+            (0.05, 0.03),
+        ] {
+            let (px, pz) = (le[0] + xp * t[0] + zp * n[0], le[1] + xp * t[1] + zp * n[1]);
+            let (u, w) = sheet.velocity_at(px, pz);
+            let (ue, we) = induced_at(px, pz, &xs, &zs, &gs, 1e-30);
+            let scale = ue.hypot(we);
+            assert!(
+                (u - ue).hypot(w - we) < 1e-5 * scale.max(1e-3),
+                "at ({xp}, {zp}): ({u}, {w}) vs ({ue}, {we})"
             );
         }
     }
