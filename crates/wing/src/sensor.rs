@@ -76,6 +76,11 @@ pub struct SensorConfig {
     pub lowpass: bool,
     /// Low-pass cut-off (Hz; 5).
     pub cutoff_hz: f64,
+    /// Quantize the Euler angles to the servo encoders and differentiate them
+    /// (Savitzky–Golay, [`crate::differentiate`]) for the inputs (true).
+    pub encoder: bool,
+    /// Encoder counts per revolution (4096).
+    pub encoder_counts_per_rev: u32,
 }
 
 impl Default for SensorConfig {
@@ -105,6 +110,8 @@ impl Default for SensorConfig {
             moment_lsb_n_mm: 1.0 / 64.0,
             lowpass: true,
             cutoff_hz: 5.0,
+            encoder: true,
+            encoder_counts_per_rev: 4096,
         }
     }
 }
@@ -121,6 +128,7 @@ impl SensorConfig {
             white_noise: false,
             quantization: false,
             lowpass: false,
+            encoder: false,
             ..Self::default()
         }
     }

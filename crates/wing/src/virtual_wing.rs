@@ -6,8 +6,9 @@
 //! ([`BladeElement`]) whose strips run the fidelity's [`SectionModel`](crate::aero::SectionModel),
 //! giving F_x, F_y (N) and M_x, M_y, M_z (N·mm) about the sensor origin (default: wing root on
 //! the pitch axis, r_s = r0). The sensor chain ([`crate::sensor`]) adds the experiment's errors,
-//! low-passes and decimates to the dataset rate (25 Hz). Inputs are the analytic 7 inputs at
-//! the dataset rate. Trajectories run in parallel (feature `parallel`); trajectory i uses
+//! low-passes and decimates to the dataset rate (25 Hz). Inputs are the 7 inputs at the dataset
+//! rate, from encoder-quantized, Savitzky–Golay-differentiated angles (or the analytic ones
+//! when `sensor.encoder` is off). Trajectories run in parallel (feature `parallel`); trajectory i uses
 //! ChaCha8 stream i of the seed, so results do not depend on threading.
 
 use crate::aero::SectionModelFactory;
@@ -97,6 +98,14 @@ pub enum SimulateError {
         index: usize,
         /// Cause.
         source: CycleError,
+    },
+    /// Differentiating the encoder angles failed.
+    #[error("trajectory {index}: encoder differentiation: {source}")]
+    Differentiate {
+        /// Trajectory index.
+        index: usize,
+        /// Cause.
+        source: crate::differentiate::DifferentiateError,
     },
     /// Non-finite loads were produced.
     #[error("trajectory {index}: non-finite load at raw sample {sample}")]
@@ -333,7 +342,24 @@ impl VirtualWing {
             rng,
         );
         outputs.truncate(sampling.n_samples);
-        let decimated: Vec<&EulerState> = states
+        let measured = if self.cfg.sensor.encoder {
+            use crate::differentiate::{SavitzkyGolay, SavitzkyGolayConfig, quantize_to_encoder};
+            let counts = self.cfg.sensor.encoder_counts_per_rev;
+            let angles: Vec<[f64; 3]> = states
+                .iter()
+                .map(|s| s.angles_rad.map(|a| quantize_to_encoder(a, counts)))
+                .collect();
+            let sg = SavitzkyGolay::new(SavitzkyGolayConfig::default())
+                .map_err(|source| SimulateError::Differentiate { index, source })?;
+            let mut out = vec![EulerState::default(); angles.len()];
+            let mut column = vec![0.0; angles.len()];
+            sg.euler_states(&angles, sampling.raw_dt_s(), &mut out, &mut column)
+                .map_err(|source| SimulateError::Differentiate { index, source })?;
+            out
+        } else {
+            states
+        };
+        let decimated: Vec<&EulerState> = measured
             .iter()
             .step_by(sampling.decimation.max(1))
             .take(sampling.n_samples)

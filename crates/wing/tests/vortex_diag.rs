@@ -27,7 +27,11 @@ fn diag_eldredge() {
         u_ref_m_s: 1.0,
         rho_kg_m3: 1.0,
         pivot_frac: 0.0,
-        lesp_crit: Some(0.11),
+        lesp_crit: std::env::var("LESP")
+            .ok()
+            .map(|s| s.parse().unwrap())
+            .or(Some(0.11))
+            .filter(|&x: &f64| x > 0.0),
         lev_decay_chords: None,
         tev_decay_chords: None,
         far_field_chords: None,
@@ -97,7 +101,8 @@ fn diag_eldredge() {
         }
         if k % 5 == 0 || std::env::var("ALL").is_ok() {
             println!(
-                "CNimp {cn_imp:7.3} CLimp {cl_imp:7.3} CN {:7.3} t {t:.3} a {:5.1} CL {cl:7.3} CN [{:7.3} {:7.3} {:7.3}] A0 {:6.3} A0u {:6.3} nlev {nl} GL {gl:7.3} dmin {dmin:6.3} xc {:6.3}",
+                "CNimp {cn_imp:7.3} CNcor {:7.3} CN {:7.3} t {t:.3} a {:5.1} CL {cl:7.3} CN [{:7.3} {:7.3} {:7.3}] A0 {:6.3} A0u {:6.3} nlev {nl} GL {gl:7.3} dmin {dmin:6.3} xc {:6.3}",
+                2.0 * d.normal_terms_n_m[3],
                 2.0 * ld.normal_n_m,
                 a.to_degrees(),
                 2.0 * d.normal_terms_n_m[0],

@@ -12,10 +12,10 @@ use flapssm_prssm::train::bench::{
 #[derive(Args)]
 pub struct BenchArgs {
     /// Minibatches timed (of 32 per epoch of 512 sequences); the epoch time is extrapolated.
-    #[arg(long, default_value_t = 32)]
-    batches: usize,
+    #[arg(long, default_value_t = 32, value_parser = clap::value_parser!(u8).range(1..=32))]
+    batches: u8,
     /// Repetitions of the prediction timing (median reported).
-    #[arg(long, default_value_t = 9)]
+    #[arg(long, default_value_t = 9, value_parser = super::positive::<usize>)]
     reps: usize,
     /// Seed of the synthetic data and parameters.
     #[arg(long, default_value_t = 0)]
@@ -27,7 +27,7 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
     let threads = rayon::current_num_threads();
     let (elbo, params) =
         paper_objective(512, 470, args.seed).context("building the paper objective")?;
-    let n_batches = args.batches.clamp(1, 32);
+    let n_batches = usize::from(args.batches);
     let (secs, points) =
         time_batches(&elbo, &params, n_batches, args.seed).context("timing training batches")?;
     let epoch_s = secs * 32.0 / n_batches as f64;

@@ -6,7 +6,9 @@ use std::path::PathBuf;
 use anyhow::{Context, bail};
 use clap::Args;
 use flapssm_data::table::Table;
-use flapssm_prssm::PrssmModel;
+use flapssm_prssm::train::InitialStateSpec;
+use flapssm_prssm::train::fit::training_record;
+use flapssm_prssm::{Normalization, PrssmModel};
 
 /// Open-loop prediction with a PR-SSM model.
 #[derive(Args)]
@@ -22,12 +24,12 @@ pub struct PredictArgs {
     #[arg(long)]
     inputs: Option<PathBuf>,
     /// Number of particles.
-    #[arg(long, default_value_t = 30)]
+    #[arg(long, default_value_t = 30, value_parser = super::positive::<usize>)]
     particles: usize,
     /// Seed of the particle draws.
     #[arg(long, default_value_t = 0)]
     seed: u64,
-    /// Output CSV: step, mean_0.., var_0..
+    /// Output file: with --inputs a CSV (step, mean_0.., var_0..), with DATASET an .npz.
     #[arg(long)]
     out: PathBuf,
 }
@@ -49,6 +51,16 @@ pub fn run(args: PredictArgs) -> anyhow::Result<()> {
             table.columns.len()
         );
     }
+    if let Ok(r) = training_record(&model)
+        && r.initial_state.spec != InitialStateSpec::Zeros
+    {
+        eprintln!(
+            "warning: {} was trained with the initial-state rule {:?}, which needs the first \
+             outputs; --inputs predicts from x_0 = 0 (predict a dataset to apply the rule)",
+            args.model.display(),
+            r.initial_state.spec
+        );
+    }
     let t_n = table.n_rows();
     let inputs: Vec<f64> = (0..t_n)
         .flat_map(|t| table.columns.iter().map(move |c| c[t]))
@@ -68,14 +80,17 @@ pub fn run(args: PredictArgs) -> anyhow::Result<()> {
 
 /// `flapssm predict MODEL DATASET --out PRED.npz`: arrays `output_mean`, `output_var`
 /// (n_traj × T × D_y, raw units), `latent_mean`, `latent_var` (n_traj × T × D_x,
-/// standardized), `y` (observed outputs, if any) and `is_train` (n_traj).
+/// standardized), `y` (observed outputs, if any) and `is_train` (n_traj). A model without
+/// normalization statistics (the published one) works in standardized units: the dataset's
+/// training statistics are used.
 fn run_dataset(args: PredictArgs) -> anyhow::Result<()> {
     use flapssm_data::npz::{NpyData, NpzWriter};
     use flapssm_prssm::train::fit::predict_raw;
+    use rayon::prelude::*;
     let Some(ds_path) = args.dataset.as_ref() else {
         bail!("give a DATASET or --inputs");
     };
-    let model = PrssmModel::load(&args.model)
+    let mut model = PrssmModel::load(&args.model)
         .with_context(|| format!("loading model {}", args.model.display()))?;
     let ds = flapssm_data::Dataset::load(ds_path)
         .with_context(|| format!("loading dataset {}", ds_path.display()))?;
@@ -90,23 +105,56 @@ fn run_dataset(args: PredictArgs) -> anyhow::Result<()> {
             args.model.display()
         );
     }
+    if model.normalization.is_none() {
+        let s = ds.standardization().with_context(|| {
+            format!(
+                "{} has no normalization statistics (standardized units) and {} has none to \
+                 offer",
+                args.model.display(),
+                ds_path.display()
+            )
+        })?;
+        eprintln!(
+            "note: {} has no normalization statistics; standardizing with the training \
+             statistics of {}",
+            args.model.display(),
+            ds_path.display()
+        );
+        model.normalization = Some(Normalization {
+            input_mean: s.mean_u.to_vec(),
+            input_std: s.std_u.to_vec(),
+            output_mean: s.mean_y.to_vec(),
+            output_std: s.std_y.to_vec(),
+        });
+    }
     let (n, t_n) = (ds.len(), ds.n_samples());
+    let bar = super::progress_bar(n as u64, "trajectories")?;
+    let preds = ds
+        .trajectories
+        .par_iter()
+        .enumerate()
+        .map(|(i, traj)| {
+            let seq = super::train::trajectory_sequence(traj);
+            let p = predict_raw(
+                &model,
+                &seq,
+                args.particles,
+                args.seed.wrapping_add(i as u64),
+            )
+            .with_context(|| format!("{}: trajectory {i}", ds_path.display()));
+            bar.inc(1);
+            p.map(|p| (p, seq.outputs))
+        })
+        .collect::<anyhow::Result<Vec<_>>>()?;
+    bar.finish_and_clear();
     let mut out: [Vec<f64>; 4] = Default::default();
     let mut y = Vec::new();
-    for (i, traj) in ds.trajectories.iter().enumerate() {
-        let seq = super::train::trajectory_sequence(traj);
-        let p = predict_raw(
-            &model,
-            &seq,
-            args.particles,
-            args.seed.wrapping_add(i as u64),
-        )
-        .with_context(|| format!("{}: trajectory {i}", ds_path.display()))?;
+    for (p, outputs) in preds {
         out[0].extend(p.output_mean);
         out[1].extend(p.output_var);
         out[2].extend(p.latent_mean);
         out[3].extend(p.latent_var);
-        y.extend(seq.outputs);
+        y.extend(outputs);
     }
     let [om, ov, lm, lv] = out;
     let mut w = NpzWriter::new();

@@ -256,7 +256,8 @@ fn finish(model: &LrqsmModel, out: &Path, json: bool) -> Result<()> {
 }
 
 fn predict(a: PredictArgs) -> Result<()> {
-    let model = LrqsmModel::load(&a.model)?;
+    let model = LrqsmModel::load(&a.model)
+        .with_context(|| format!("loading LRQSM model {}", a.model.display()))?;
     let ds = load_dataset(&a.dataset)?;
     let mode = if a.published {
         InterceptMode::Dropped

@@ -25,22 +25,22 @@ pub struct TrainArgs {
     #[arg(long, default_value = "paper")]
     preset: Preset,
     /// Latent dimension D_x.
-    #[arg(long)]
+    #[arg(long, value_parser = super::positive::<usize>)]
     dx: Option<usize>,
     /// Number of inducing points M.
-    #[arg(long)]
+    #[arg(long, value_parser = super::positive::<usize>)]
     inducing: Option<usize>,
     /// Particles per window.
-    #[arg(long)]
+    #[arg(long, value_parser = super::positive::<usize>)]
     particles: Option<usize>,
     /// Epochs (whole passes over all windows).
-    #[arg(long, conflicts_with = "iterations")]
+    #[arg(long, conflicts_with = "iterations", value_parser = super::positive::<u64>)]
     epochs: Option<u64>,
     /// Optimizer steps instead of epochs.
-    #[arg(long)]
+    #[arg(long, value_parser = super::positive::<u64>)]
     iterations: Option<u64>,
     /// Windows per minibatch.
-    #[arg(long)]
+    #[arg(long, value_parser = super::positive::<usize>)]
     batch: Option<usize>,
     /// Adam learning rate.
     #[arg(long)]
@@ -127,7 +127,7 @@ pub fn run(args: TrainArgs) -> anyhow::Result<()> {
     if !(0.0..1.0).contains(&args.val_fraction) {
         bail!("--val-fraction {} must be in [0, 1)", args.val_fraction);
     }
-    let n_val = ((all.len() as f64 * args.val_fraction).round() as usize).min(all.len() - 1);
+    let n_val = ((all.len() as f64 * args.val_fraction).round() as usize).min(all.len().saturating_sub(1));
     let (train_seqs, val_seqs) = all.split_at(all.len() - n_val);
     if train_seqs.is_empty() {
         bail!("{}: no training trajectories", args.dataset.display());
@@ -219,7 +219,7 @@ pub fn run(args: TrainArgs) -> anyhow::Result<()> {
             lr_scale,
             retry,
         } => say(format!(
-            "warning: step {step} rejected ({reason}); step undone, learning rate scaled to {lr_scale:.3e} (retry {retry})"
+            "warning: step {step} rejected ({reason}); step undone, learning-rate factor now {lr_scale:.3e} (retry {retry})"
         )),
         TrainEvent::Checkpoint { path, step } => {
             say(format!("checkpoint at step {step} -> {}", path.display()))
@@ -231,14 +231,17 @@ pub fn run(args: TrainArgs) -> anyhow::Result<()> {
         _ => {}
     };
     println!(
-        "{}: {} training / {} validation trajectories; D_x {}, M {}, {} particles, {:?}",
+        "{}: {} training / {} validation trajectories; D_x {}, M {}, {} particles, {}",
         args.dataset.display(),
         train_seqs.len(),
         val_seqs.len(),
         spec.model.n_state,
         spec.model.n_inducing,
         spec.particles,
-        spec.train.budget
+        match spec.train.budget {
+            Budget::Epochs(n) => format!("{n} epochs"),
+            Budget::Iterations(n) => format!("{n} iterations"),
+        }
     );
     let out = fit(
         &spec,

@@ -47,8 +47,8 @@ pub struct LdvmDiagnostics {
     /// Number of free vortices after this step.
     pub n_vortices: usize,
     /// Terms of N' (N/m): [ρV_t cπ(B0 + B1/2) (circulatory, plate motion), ρΣ u_t,j Γ_j (free-vortex
-    /// induced), ρπc²(¾Ḃ0 + ¼Ḃ1 + ⅛Ḃ2) (unsteady)].
-    pub normal_terms_n_m: [f64; 3],
+    /// induced), ρπc²(¾Ḃ0 + ¼Ḃ1 + ⅛Ḃ2) (unsteady), −ρcΓ_LEV/Δt (LE feeding sheet)].
+    pub normal_terms_n_m: [f64; 4],
 }
 
 /// 2-D LDVM for a flat plate. Built once, stepped with [`Ldvm::step`]; all storage is
@@ -353,8 +353,9 @@ impl Ldvm {
             rho * vt * kb(b0, b1),
             rho * sum_ut,
             rho * PI * c * c * (NF[0] * bd(0, self) + NF[1] * bd(1, self) + NF[2] * bd(2, self)),
+            -rho * c * g_lev / dt_s,
         ];
-        let normal = n_terms[0] + n_terms[1] + n_terms[2];
+        let normal = n_terms.iter().sum::<f64>();
         let m_le = rho * (vt * c * c * PI * (0.25 * b0 + 0.25 * b1 - 0.125 * b2) + sum_xut)
             + rho
                 * PI
@@ -362,7 +363,8 @@ impl Ldvm {
                 * (MF[0] * bd(0, self)
                     + MF[1] * bd(1, self)
                     + MF[2] * bd(2, self)
-                    + MF[3] * bd(3, self));
+                    + MF[3] * bd(3, self))
+            + 0.5 * c * n_terms[3];
         let loads = SectionLoads {
             normal_n_m: normal,
             chord_n_m: -self.p.suction_factor * rho * PI * c * b0 * b0,
