@@ -180,51 +180,30 @@ impl Posterior {
     }
 }
 
-/// Values kept for the reverse mode of one step: the scaled inputs `X̃` (`D × N`), `K`,
-/// `σ_f² g'` (replaced by `W̄` once used) and `W` (`M × N` each), `μ̄` and `σ̄²` (`D_x × N`).
+/// Per-step values kept for the reverse mode: the scaled inputs `X̃` (`D × N`), `K`, `σ_f² g'`
+/// and `W` (`M × N` each), stored in one slice of [`tape_len`] values.
 struct Tape<'a> {
     xs: &'a mut [f64],
     k: &'a mut [f64],
     kd: &'a mut [f64],
     w: &'a mut [f64],
-    mbar: &'a mut [f64],
-    vbar: &'a mut [f64],
 }
 
 /// Values per step stored for the reverse mode of a batch of `capacity` points.
-///
-/// A tape of `S` steps holds one plane per quantity (`X̃`, `K`, `σ_f² g'`/`W̄`, `W`, `μ̄`,
-/// `σ̄²`), each `S` consecutive column-major blocks of `capacity` columns, so that the
-/// parameter adjoints of a whole segment are single products with `capacity·S` columns.
 pub fn tape_len(post: &Posterior, capacity: usize) -> usize {
-    (post.d + 3 * post.m + 2 * post.dx) * capacity
+    (post.d + 3 * post.m) * capacity
 }
 
-/// Plane row counts in tape order.
-fn planes(post: &Posterior) -> [usize; 6] {
-    [post.d, post.m, post.m, post.m, post.dx, post.dx]
-}
-
-fn split_tape<'a>(
-    post: &Posterior,
-    (cap, seg, slot, n): (usize, usize, usize, usize),
-    tape: &'a mut [f64],
-) -> Tape<'a> {
-    let mut rest = tape;
-    let mut out: [&'a mut [f64]; 6] = Default::default();
-    for (o, rows) in out.iter_mut().zip(planes(post)) {
-        let (pl, r) = rest.split_at_mut(rows * cap * seg);
-        rest = r;
-        *o = &mut pl[slot * rows * cap..][..rows * n];
-    }
-    let [xs, k, kd, w, mbar, vbar] = out;
+fn split_tape<'a>(post: &Posterior, cap: usize, n: usize, tape: &'a mut [f64]) -> Tape<'a> {
+    let (d, m) = (post.d, post.m);
+    let (xs, rest) = tape.split_at_mut(d * cap);
+    let (k, rest) = rest.split_at_mut(m * cap);
+    let (kd, w) = rest.split_at_mut(m * cap);
     Tape {
-        xs,
-        k,
-        kd,
-        w,
-        mbar,
-        vbar,
+        xs: &mut xs[..d * n],
+        k: &mut k[..m * n],
+        kd: &mut kd[..m * n],
+        w: &mut w[..m * n],
     }
 }
 
@@ -330,29 +309,15 @@ impl ConditionalWorkspace {
     /// [`Self::mean`] / [`Self::var`]. Allocates nothing.
     pub fn forward(&mut self, post: &Posterior, n: usize) {
         let mut tape = std::mem::take(&mut self.tape);
-        self.forward_tape(post, n, &mut tape, 1, 0);
+        self.forward_tape(post, n, &mut tape);
         self.tape = tape;
     }
 
-    /// [`Self::forward`] storing the step's intermediates in slot `slot` of a tape of `seg`
-    /// steps (`seg ·` [`tape_len`] values).
-    pub(crate) fn forward_tape(
-        &mut self,
-        post: &Posterior,
-        n: usize,
-        tape: &mut [f64],
-        seg: usize,
-        slot: usize,
-    ) {
-        let (m, d, dx, cap) = (post.m, post.d, post.dx, self.cap);
-        debug_assert!(n <= cap);
-        if n < cap {
-            // Columns n.. of K and W enter the segment products (with zero adjoints).
-            let t = split_tape(post, (cap, seg, slot, cap), tape);
-            t.k[m * n..].fill(0.0);
-            t.w[m * n..].fill(0.0);
-        }
-        let t = split_tape(post, (cap, seg, slot, n), tape);
+    /// [`Self::forward`] storing the step's intermediates in `tape` ([`tape_len`] values).
+    pub(crate) fn forward_tape(&mut self, post: &Posterior, n: usize, tape: &mut [f64]) {
+        let (m, d, dx) = (post.m, post.d, post.dx);
+        debug_assert!(n <= self.cap);
+        let t = split_tape(post, self.cap, n, tape);
         kernel::scale_points(&self.input[..d * n], &post.inv_len, t.xs);
         kernel::cross_cov_grouped(
             post.kind,
@@ -436,38 +401,33 @@ impl ConditionalWorkspace {
         xbar: &mut [f64],
     ) {
         let mut tape = std::mem::take(&mut self.tape);
-        self.backward_tape(post, n, &mut tape, (1, 0), mean_bar, var_bar, grads, xbar);
-        self.segment_grads(post, &mut tape, 1, 1, grads);
+        self.backward_tape(post, n, &mut tape, mean_bar, var_bar, grads, xbar);
         self.tape = tape;
     }
 
-    /// [`Self::backward`] from the intermediates [`Self::forward_tape`] stored in slot
-    /// `slot` of a tape of `seg` steps, except the adjoints of `m`, diagonal `S` and `G`:
-    /// their inputs are left in the tape for [`Self::segment_grads`].
+    /// [`Self::backward`] from the intermediates a [`Self::forward_tape`] stored in `tape`.
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn backward_tape(
         &mut self,
         post: &Posterior,
         n: usize,
         tape: &mut [f64],
-        (seg, slot): (usize, usize),
         mean_bar: &[f64],
         var_bar: &[f64],
         grads: &mut ConditionalGrads,
         xbar: &mut [f64],
     ) {
-        let (m, dx, cap) = (post.m, post.dx, self.cap);
-        if n < cap {
-            let t = split_tape(post, (cap, seg, slot, cap), tape);
-            t.mbar[dx * n..].fill(0.0);
-            t.vbar[dx * n..].fill(0.0);
-            t.kd[m * n..].fill(0.0);
-        }
-        let t = split_tape(post, (cap, seg, slot, n), tape);
-        t.mbar.copy_from_slice(&mean_bar[..dx * n]);
-        t.vbar.copy_from_slice(&var_bar[..dx * n]);
+        let (m, dx) = (post.m, post.dx);
+        let t = split_tape(post, self.cap, n, tape);
         let (w, k) = (&*t.w, &*t.k);
-        // μ = mᵀ W: W̄ = m μ̄ (m̄ᵀ += μ̄ Wᵀ in segment_grads).
+        // μ = mᵀ W: m̄ᵀ += μ̄ Wᵀ, W̄ = m μ̄.
+        gemm(
+            view_mut(&mut grads.q_mean, dx, m),
+            Accum::Add,
+            view(mean_bar, dx, n),
+            view(w, m, n).transpose(),
+            1.0,
+        );
         gemm(
             view_mut(&mut self.wbar, m, n),
             Accum::Replace,
@@ -477,7 +437,16 @@ impl ConditionalWorkspace {
         );
         match post.cov {
             CovarianceStructure::Diagonal => {
-                // σ² ∋ S (W⊙W): W̄ += 2 W ⊙ (Sᵀσ̄²) (S̄ᵀ += σ̄² (W⊙W)ᵀ in segment_grads).
+                for (w2, &wv) in self.w2[..m * n].iter_mut().zip(w) {
+                    *w2 = wv * wv;
+                }
+                gemm(
+                    view_mut(&mut grads.q_cov, dx, m),
+                    Accum::Add,
+                    view(var_bar, dx, n),
+                    view(&self.w2, m, n).transpose(),
+                    1.0,
+                );
                 gemm(
                     view_mut(&mut self.kbar, m, n),
                     Accum::Replace,
@@ -554,7 +523,7 @@ impl ConditionalWorkspace {
                 }
             }
         }
-        // W = G K: K̄ += Gᵀ W̄ (Ḡ += W̄ Kᵀ in segment_grads, W̄ kept in place of σ_f² g').
+        // W = G K: K̄ += Gᵀ W̄, Ḡ += W̄ Kᵀ.
         gemm(
             view_mut(kbar, m, n),
             Accum::Add,
@@ -562,9 +531,15 @@ impl ConditionalWorkspace {
             view(&self.wbar, m, n),
             1.0,
         );
+        gemm(
+            view_mut(&mut grads.gbar, m, m),
+            Accum::Add,
+            view(&self.wbar, m, n),
+            view(k, m, n).transpose(),
+            1.0,
+        );
         grads.variance += dot(kbar, k) / post.variance;
         kbar.iter_mut().zip(&*t.kd).for_each(|(kb, &kd)| *kb *= kd);
-        t.kd.copy_from_slice(&self.wbar[..m * n]);
         kernel::cross_cov_backward(
             kbar,
             &post.zt,
@@ -577,54 +552,6 @@ impl ConditionalWorkspace {
             &mut self.cx,
             &mut self.zc[..post.d * n],
             &mut self.rowsum,
-        );
-    }
-
-    /// The adjoints of `m`, diagonal `S` and `G` of the first `steps` slots of a tape of
-    /// `seg` steps after [`Self::backward_tape`] of each: one product per parameter over all
-    /// `capacity·steps` columns, `m̄ᵀ += μ̄ Wᵀ`, `S̄ᵀ += σ̄² (W⊙W)ᵀ`, `Ḡ += W̄ Kᵀ`. Overwrites
-    /// the slots' `W` with `W⊙W`.
-    pub(crate) fn segment_grads(
-        &mut self,
-        post: &Posterior,
-        tape: &mut [f64],
-        seg: usize,
-        steps: usize,
-        grads: &mut ConditionalGrads,
-    ) {
-        let (m, dx) = (post.m, post.dx);
-        let cols = self.cap * steps;
-        let mut rest = tape;
-        let mut pl: [&mut [f64]; 6] = Default::default();
-        for (o, rows) in pl.iter_mut().zip(planes(post)) {
-            let (a, r) = rest.split_at_mut(rows * self.cap * seg);
-            rest = r;
-            *o = &mut a[..rows * cols];
-        }
-        let [_, k, wbar, w, mbar, vbar] = pl;
-        gemm(
-            view_mut(&mut grads.q_mean, dx, m),
-            Accum::Add,
-            view(mbar, dx, cols),
-            view(w, m, cols).transpose(),
-            1.0,
-        );
-        if post.cov == CovarianceStructure::Diagonal {
-            w.iter_mut().for_each(|v| *v *= *v);
-            gemm(
-                view_mut(&mut grads.q_cov, dx, m),
-                Accum::Add,
-                view(vbar, dx, cols),
-                view(w, m, cols).transpose(),
-                1.0,
-            );
-        }
-        gemm(
-            view_mut(&mut grads.gbar, m, m),
-            Accum::Add,
-            view(wbar, m, cols),
-            view(k, m, cols).transpose(),
-            1.0,
         );
     }
 }

@@ -666,7 +666,7 @@ impl Elbo {
         let n_steps = t_max.saturating_sub(1);
         let seg = (self.tape_budget_bytes / (8 * tape_step.max(1))).clamp(1, n_steps.max(1));
         let mut tape = std::mem::take(&mut scratch.tape);
-        tape.resize(seg * tape_step, 0.0);
+        tape.resize(seg.min(n_steps) * tape_step, 0.0);
         // Standard deviations √(σ² + σ_x² + δ) of every step, `(T − 1) × D_x × N`.
         let mut sds = std::mem::take(&mut scratch.sds);
         sds.resize(n_steps * step, 0.0);
@@ -675,12 +675,11 @@ impl Elbo {
                          xs: &mut [f64],
                          sds: &mut [f64],
                          t: usize| {
-            let slot = t % seg;
             let (cur, next) = xs.split_at_mut((t + 1) * step);
             let x = &cur[t * step..];
             let na = active[t + 1];
             fill_input(ws, x, t, na);
-            ws.forward_tape(post, na, tape, seg, slot);
+            ws.forward_tape(post, na, tape);
             let e = &eps[t * step..];
             let xn = &mut next[..step];
             let sd_t = &mut sds[t * step..(t + 1) * step];
@@ -697,7 +696,14 @@ impl Elbo {
         for t in 0..t_max {
             nll += likelihood(&xs[t * step..(t + 1) * step], t, None, &mut vy_bar);
             if t < n_steps {
-                propagate(&mut ws, &mut tape, &mut xs, &mut sds, t);
+                let slot = (t % seg) * tape_step;
+                propagate(
+                    &mut ws,
+                    &mut tape[slot..slot + tape_step],
+                    &mut xs,
+                    &mut sds,
+                    t,
+                );
             }
         }
         // Backward.
@@ -713,7 +719,14 @@ impl Elbo {
                     // Recompute segment s (steps s·seg ..= t) into the tape; the states it
                     // rewrites come out identical.
                     for r in s * seg..=t {
-                        propagate(&mut ws, &mut tape, &mut xs, &mut sds, r);
+                        let slot = (r % seg) * tape_step;
+                        propagate(
+                            &mut ws,
+                            &mut tape[slot..slot + tape_step],
+                            &mut xs,
+                            &mut sds,
+                            r,
+                        );
                     }
                 }
                 let na = active[t + 1];
@@ -729,20 +742,16 @@ impl Elbo {
                         vx_bar[dd] += vb;
                     }
                 }
+                let slot = (t % seg) * tape_step;
                 ws.backward_tape(
                     post,
                     na,
-                    &mut tape,
-                    (seg, t % seg),
+                    &mut tape[slot..slot + tape_step],
                     &mean_bar[..dx * na],
                     &var_bar[..dx * na],
                     &mut cond,
                     &mut xbar,
                 );
-                if t % seg == 0 {
-                    let steps = seg.min(n_steps - t);
-                    ws.segment_grads(post, &mut tape, seg, steps, &mut cond);
-                }
             }
             likelihood(
                 &xs[t * step..(t + 1) * step],

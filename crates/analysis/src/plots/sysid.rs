@@ -93,3 +93,24 @@ pub fn plot_test_prediction(
         Ok::<(), Box<dyn std::error::Error>>(())
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn writes_png_and_rejects_mismatched_series() {
+        let dir = tempfile::tempdir().unwrap();
+        let names = vec!["p".to_string(), "q".to_string()];
+        let y: Vec<f64> = (0..40).map(|i| (i as f64 * 0.3).sin()).collect();
+        let var = vec![0.04; 40];
+        let path = dir.path().join("fig.png");
+        plot_test_prediction(&path, "t", &names, &y, &y, &var).unwrap();
+        let bytes = std::fs::read(&path).unwrap();
+        assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n");
+        let e = plot_test_prediction(&path, "t", &names, &y, &y[..38], &var[..38]).unwrap_err();
+        assert!(matches!(e, AnalysisError::Shape { .. }), "{e}");
+        let e = plot_test_prediction(&path, "t", &names, &y[..39], &y[..39], &var[..39]);
+        assert!(e.is_err());
+    }
+}

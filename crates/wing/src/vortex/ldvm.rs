@@ -2,7 +2,7 @@
 
 use std::f64::consts::PI;
 
-use super::wake::{Wake, induced_at};
+use super::wake::{PlateFrame, Wake, induced_at};
 use super::{LdvmParams, MergeParams, VortexError, VortexKind};
 
 /// Pose and velocity of the plate in the inertial plane.
@@ -85,6 +85,7 @@ pub struct Ldvm {
     step: u64,
     last_lev_step: Option<u64>,
     prev_speed_m_s: f64,
+    prev_frame: PlateFrame,
     diag: LdvmDiagnostics,
 }
 
@@ -162,6 +163,7 @@ impl Ldvm {
             step: 0,
             last_lev_step: None,
             prev_speed_m_s: 0.0,
+            prev_frame: PlateFrame::default(),
             diag: LdvmDiagnostics::default(),
             p: params,
         })
@@ -396,6 +398,11 @@ impl Ldvm {
         self.b_prev.copy_from_slice(&self.b);
         self.dt_prev_s = dt_s;
         self.prev_speed_m_s = speed;
+        self.prev_frame = PlateFrame {
+            le,
+            t: [tx, tz],
+            n: [nx, nz],
+        };
         self.step += 1;
         Ok(loads)
     }
@@ -432,7 +439,16 @@ impl Ldvm {
     /// Convects, decays, deletes and amalgamates the free vortices over the step of `dt_s`.
     fn advance_wake(&mut self, plate: &PlateState, dt_s: f64, speed: f64) {
         let c = self.c;
-        self.wake.convect(dt_s);
+        let (s, co) = plate.angle_rad.sin_cos();
+        let frame = PlateFrame {
+            le: [
+                plate.pivot_m[0] - self.xp * co,
+                plate.pivot_m[1] - self.xp * s,
+            ],
+            t: [co, s],
+            n: [-s, co],
+        };
+        self.wake.convect(dt_s, &self.prev_frame, &frame, c);
         let travel_chords = 0.5 * (speed + self.prev_speed_m_s) * dt_s / c;
         let f = |s: Option<f64>| s.map_or(1.0, |s| (-travel_chords / s).exp());
         let (f_tev, f_lev) = (f(self.p.tev_decay_chords), f(self.p.lev_decay_chords));

@@ -7,6 +7,25 @@
 
 use std::f64::consts::PI;
 
+/// Pose of the plate: leading edge, chord unit vector t̂ (LE → TE) and normal n̂.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub(crate) struct PlateFrame {
+    pub le: [f64; 2],
+    pub t: [f64; 2],
+    pub n: [f64; 2],
+}
+
+impl PlateFrame {
+    /// Chord and normal coordinates (m) of the point (x, z) relative to the LE.
+    pub fn local(&self, x: f64, z: f64) -> (f64, f64) {
+        let (dx, dz) = (x - self.le[0], z - self.le[1]);
+        (
+            dx * self.t[0] + dz * self.t[1],
+            dx * self.n[0] + dz * self.n[1],
+        )
+    }
+}
+
 /// Where a free vortex was shed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum VortexKind {
@@ -180,11 +199,20 @@ impl Wake {
         }
     }
 
-    /// Moves every vortex by its stored velocity times `dt_s` (forward Euler).
-    pub(crate) fn convect(&mut self, dt_s: f64) {
+    /// Moves every vortex by its stored velocity times `dt_s` (forward Euler). A vortex that
+    /// would pass through the plate (its normal coordinate changes sign between the plate pose
+    /// `before` and `after` while its chord coordinate stays within [0, c]) is mirrored back to
+    /// its side: the discrete sheet cannot stop a vortex closer to the plate than its resolution.
+    pub(crate) fn convect(&mut self, dt_s: f64, before: &PlateFrame, after: &PlateFrame, c: f64) {
         for i in 0..self.len() {
+            let (x0, z0) = before.local(self.x[i], self.z[i]);
             self.x[i] += self.u[i] * dt_s;
             self.z[i] += self.w[i] * dt_s;
+            let (x1, z1) = after.local(self.x[i], self.z[i]);
+            if z0 * z1 < 0.0 && (0.0..=c).contains(&x0) && (0.0..=c).contains(&x1) {
+                self.x[i] -= 2.0 * z1 * after.n[0];
+                self.z[i] -= 2.0 * z1 * after.n[1];
+            }
         }
     }
 

@@ -1,0 +1,153 @@
+//! `flapssm train` on a small simulated dataset: the model files load and predict, a run
+//! interrupted with Ctrl-C and resumed ends bit-identical to an uninterrupted one, a changed
+//! configuration is refused on resume, and a divergent learning rate is reported.
+
+mod common;
+
+use std::io::{BufRead, BufReader};
+use std::path::Path;
+use std::process::{Command, Stdio};
+
+use common::{assert_fails, flapssm, ok, s, simulated};
+use flapssm_prssm::PrssmModel;
+
+const EPOCHS: &str = "60";
+
+/// Tiny configuration: D_x 5, M 10, 4 particles, batches of 2 sequences.
+fn train_args<'a>(data: &'a Path, out: &'a Path, epochs: &'a str) -> Vec<&'a str> {
+    vec![
+        "train",
+        s(data),
+        "--out",
+        s(out),
+        "--dx",
+        "5",
+        "--inducing",
+        "10",
+        "--particles",
+        "4",
+        "--batch",
+        "2",
+        "--epochs",
+        epochs,
+        "--seed",
+        "7",
+        "--checkpoint-every",
+        "5",
+    ]
+}
+
+fn json(path: &Path) -> serde_json::Value {
+    serde_json::from_slice(&std::fs::read(path).unwrap()).unwrap()
+}
+
+/// Runs training, sends SIGINT once the first epoch is reported, and waits.
+fn interrupted_run(args: &[&str]) -> (Option<i32>, String) {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_flapssm"))
+        .args(args)
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut lines = BufReader::new(child.stderr.take().unwrap()).lines();
+    let mut err = String::new();
+    for line in lines.by_ref() {
+        let line = line.unwrap();
+        err.push_str(&line);
+        err.push('\n');
+        if line.starts_with("epoch") {
+            let kill = Command::new("kill")
+                .args(["-INT", &child.id().to_string()])
+                .status()
+                .unwrap();
+            assert!(kill.success());
+            break;
+        }
+    }
+    for line in lines {
+        err.push_str(&line.unwrap());
+        err.push('\n');
+    }
+    (child.wait().unwrap().code(), err)
+}
+
+#[test]
+fn ctrl_c_then_resume_is_bit_identical_and_the_model_predicts() {
+    let dir = tempfile::tempdir().unwrap();
+    let data = simulated(dir.path(), 12, 2);
+
+    let a = dir.path().join("a.json");
+    let stdout = ok(&train_args(&data, &a, EPOCHS));
+    assert!(stdout.contains("60 epochs"), "{stdout}");
+
+    let b = dir.path().join("b.json");
+    let ckpt = dir.path().join("b.ckpt.json");
+    let (code, err) = interrupted_run(&train_args(&data, &b, EPOCHS));
+    assert_eq!(code, Some(1), "{err}");
+    assert!(err.contains("interrupted at step"), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+    assert!(ckpt.exists() && !b.exists(), "{err}");
+    let step = json(&ckpt)["state"]["step"].as_u64().unwrap();
+    assert!(step > 0 && step < 300, "interrupted at step {step}");
+
+    ok(&[&train_args(&data, &b, EPOCHS)[..], &["--resume"]].concat());
+    for (x, y) in [(a.clone(), b.clone()), (dir.path().join("a.last.json"), dir.path().join("b.last.json"))] {
+        let (mx, my) = (json(&x)["model"].clone(), json(&y)["model"].clone());
+        assert!(
+            mx["params"] == my["params"],
+            "{} and {} differ",
+            x.display(),
+            y.display()
+        );
+        assert_eq!(mx["training"]["history"], my["training"]["history"]);
+    }
+    let history = json(&b)["model"]["training"]["history"].clone();
+    assert_eq!(history.as_array().unwrap().len(), 60);
+
+    let model = PrssmModel::load(&b).unwrap();
+    assert_eq!(
+        (model.config.n_state, model.config.n_inducing, model.config.n_input),
+        (5, 10, 7)
+    );
+    assert!(model.normalization.is_some());
+    let pred = dir.path().join("pred.npz");
+    ok(&["predict", s(&b), s(&data), "--particles", "4", "--out", s(&pred)]);
+    let mean = flapssm_data::npz::NpzReader::open(&pred)
+        .unwrap()
+        .f64_shaped("output_mean", &[12, 470, 5])
+        .unwrap();
+    assert!(mean.iter().all(|m| m.is_finite()));
+}
+
+#[test]
+fn resuming_with_another_configuration_is_refused_naming_the_field() {
+    let dir = tempfile::tempdir().unwrap();
+    let data = simulated(dir.path(), 6, 1);
+    let first = dir.path().join("m.json");
+    ok(&train_args(&data, &first, "2"));
+    let ckpt = dir.path().join("m.ckpt.json");
+    assert!(ckpt.exists());
+    let out = dir.path().join("n.json");
+    let mut args = train_args(&data, &out, "2");
+    args.extend(["--lr", "0.01", "--resume", "--checkpoint", s(&ckpt)]);
+    let o = flapssm(&args);
+    assert_fails(&o, &["lr", "0.01", s(&data)], &out);
+}
+
+#[test]
+fn a_divergent_learning_rate_is_reported_and_the_step_undone() {
+    let dir = tempfile::tempdir().unwrap();
+    let data = simulated(dir.path(), 6, 1);
+    let out = dir.path().join("m.json");
+    let mut args = train_args(&data, &out, "2");
+    args.extend(["--lr", "50"]);
+    let o = flapssm(&args);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    assert!(
+        err.contains("warning: step") && err.contains("rejected") && err.contains("step undone"),
+        "{err}"
+    );
+    assert!(err.contains("learning-rate factor now 5.000e-1"), "{err}");
+    assert!(out.exists());
+}
