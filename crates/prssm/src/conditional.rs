@@ -1,7 +1,7 @@
 //! The sparse-GP conditional `f(X) | q(u)` of all latent dims at a batch of `N` points, and
-//! its reverse mode. [`Posterior`] caches what depends only on the parameters (`L = chol(K_mm
-//! + jitter·I)`, the projection `G`, scaled `Z`); a [`ConditionalWorkspace`] holds the
-//! per-batch buffers.
+//! its reverse mode. [`Posterior`] caches what depends only on the parameters (the Cholesky
+//! factor `L` of `K_mm + jitter·I`, the projection `G`, scaled `Z`); a
+//! [`ConditionalWorkspace`] holds the per-batch buffers.
 //!
 //! With `K = K_mn` (`M × N`) and `W = G K`, where `G = (K_mm + jitter·I)⁻¹ = L⁻ᵀL⁻¹`
 //! (unwhitened) or `G = L⁻¹` (whitened):

@@ -733,13 +733,12 @@ impl Elbo {
                 let e = &eps[t * step..];
                 let sd_t = &sds[t * step..];
                 for c in 0..na {
-                    for dd in 0..dx {
+                    for (dd, vxb) in vx_bar.iter_mut().enumerate() {
                         let i = c * dx + dd;
-                        let sd = sd_t[i];
                         mean_bar[i] = xbar[i];
-                        let vb = xbar[i] * e[i] / (2.0 * sd);
+                        let vb = xbar[i] * e[i] / (2.0 * sd_t[i]);
                         var_bar[i] = vb;
-                        vx_bar[dd] += vb;
+                        *vxb += vb;
                     }
                 }
                 let slot = (t % seg) * tape_step;

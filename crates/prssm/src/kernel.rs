@@ -52,8 +52,9 @@ impl KernelKind {
 /// are clamped (no `+∞`); NaN propagates.
 #[inline(always)]
 pub fn exp(x: f64) -> f64 {
-    const LN2_HI: f64 = 6.931_471_803_691_238_164_9e-1;
-    const LN2_LO: f64 = 1.908_214_929_270_587_700_02e-10;
+    // ln2 = LN2_HI + LN2_LO, LN2_HI with 21 trailing zero bits (k·LN2_HI is exact).
+    const LN2_HI: f64 = f64::from_bits(0x3fe6_2e42_fee0_0000);
+    const LN2_LO: f64 = f64::from_bits(0x3dea_39ef_3579_3c76);
     // 1.5·2⁵²: adding it rounds to an integer, which is then the low bits of the sum.
     const SHIFT: f64 = 6_755_399_441_055_744.0;
     const C: [f64; 14] = {
@@ -192,8 +193,8 @@ fn sq_dist(zt: &[f64], m_n: usize, j0: usize, x: &[f64], init: Option<&[f64]>, o
             let b = tau_block::<8>(zt, m_n, m_n - 8, x, init);
             out[m_n - 8..m_n].copy_from_slice(&b);
         } else {
-            for m in narrow..m_n {
-                out[m] = tau_block::<1>(zt, m_n, m, x, init)[0];
+            for (m, o) in out.iter_mut().enumerate().take(m_n).skip(narrow) {
+                *o = tau_block::<1>(zt, m_n, m, x, init)[0];
             }
         }
     }

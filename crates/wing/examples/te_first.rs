@@ -27,7 +27,7 @@ fn main() {
     // Bins of |phase from nearest reversal| in cycles: 0–0.05, …, 0.20–0.25.
     let mut by_phase = [[0.0f64; 2]; 5];
     let mut by_family = vec![[0.0f64; 4]; Family::ALL.len()];
-    let (mut te, mut all, mut te_w, mut all_w) = (0.0, 0.0, 0.0, 0.0);
+    let (mut te, mut all, mut te_w, mut all_w) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
     let mut episodes: Vec<f64> = Vec::new();
     let mut states = vec![EulerState::default(); raw.n_raw()];
     for spec in &specs {

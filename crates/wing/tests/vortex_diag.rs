@@ -115,3 +115,30 @@ fn diag_eldredge() {
         }
     }
 }
+
+#[test]
+fn diag_hover() {
+    let (c, a, w) = (0.06, 0.24, 1.25);
+    let u_ref = 2.0 / PI * a * w;
+    let mut l = Ldvm::new(LdvmParams { chord_m: c, u_ref_m_s: u_ref, ..LdvmParams::default() }).unwrap();
+    let n = 600;
+    let dt = 2.0 * PI / w / n as f64;
+    let q = 0.5 * 800.0 * u_ref * u_ref * c;
+    for k in 0..(2 * n) {
+        let t = k as f64 * dt;
+        let th = PI / 2.0 - PI / 4.0 * (w * t).sin();
+        let thd = -PI / 4.0 * w * (w * t).cos();
+        let p = PlateState {
+            pivot_m: [a * (w * t).cos(), 0.5 * c * (2.0 * w * t).sin()],
+            pivot_vel_m_s: [-a * w * (w * t).sin(), c * w * (2.0 * w * t).cos()],
+            angle_rad: th,
+            angle_rate_rad_s: thd,
+        };
+        let ld = l.step(&p, dt).unwrap();
+        let d = *l.diagnostics();
+        if k % 10 == 0 || (ld.normal_n_m / q).abs() > 10.0 {
+            println!("k {k} CN {:8.3} terms {:8.3} {:8.3} {:8.3} {:8.3} lesp {:6.3} lev {:8.5} nv {}", ld.normal_n_m / q,
+                d.normal_terms_n_m[0] / q, d.normal_terms_n_m[1] / q, d.normal_terms_n_m[2] / q, d.normal_terms_n_m[3] / q, d.lesp, d.lev_m2_s, d.n_vortices);
+        }
+    }
+}
