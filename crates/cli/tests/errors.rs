@@ -5,6 +5,7 @@
 mod common;
 
 use std::path::Path;
+use std::sync::Mutex;
 
 use common::{assert_fails, flapssm, ok, reference, s, simulated};
 
@@ -13,10 +14,6 @@ fn fixtures(dir: &Path) {
     let w = |name: &str, text: &str| std::fs::write(dir.join(name), text).unwrap();
     w("corrupt.npz", "PK\u{3}\u{4} this is not a zip archive");
     w("table.csv", "a,b,c\n1,2,3\n2,3,5\n3,5,8\n4,7,9\n5,8,13\n");
-    w(
-        "nan.csv",
-        "# flapssm-dataset-csv 1\n# dt_s: 0.04\n# metadata: {}\ntrajectory,family\n0,x\n",
-    );
     let published = dir.join("published.json");
     ok(&[
         "model",
@@ -31,13 +28,36 @@ fn fixtures(dir: &Path) {
     std::fs::write(dir.join("future.json"), m.to_string()).unwrap();
     let text = std::fs::read_to_string(&published).unwrap();
     w("truncated.json", &text[..text.len() / 2]);
-    w("foreign.json", r#"{"format": "something-else", "version": 1}"#);
+    w(
+        "foreign.json",
+        r#"{"format": "something-else", "version": 1}"#,
+    );
     let data = simulated(dir, 3, 1);
     std::fs::rename(data, dir.join("data.npz")).unwrap();
+    // The exported CSV with one value (line 10, column 12: a_z) replaced by NaN.
+    let csv = dir.join("data.csv");
+    ok(&[
+        "dataset",
+        "export",
+        s(&dir.join("data.npz")),
+        "--csv",
+        s(&csv),
+    ]);
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let mut lines: Vec<String> = text.lines().map(String::from).collect();
+    let mut cells: Vec<&str> = lines[9].split(',').collect();
+    cells[11] = "NaN";
+    lines[9] = cells.join(",");
+    w("nan.csv", &(lines.join("\n") + "\n"));
 }
+
+/// Serializes the tests of this file: a process spawned by one test while the other holds
+/// an open pipe would inherit the pipe's read end for a moment and keep it alive.
+static SPAWN: Mutex<()> = Mutex::new(());
 
 #[test]
 fn bad_inputs_are_refused_naming_the_file_and_writing_nothing() {
+    let _serial = SPAWN.lock().unwrap_or_else(|e| e.into_inner());
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path();
     fixtures(dir);
@@ -45,34 +65,180 @@ fn bad_inputs_are_refused_naming_the_file_and_writing_nothing() {
     // (arguments with OUT for the output path, needles in the message)
     let cases: Vec<(Vec<String>, Vec<String>)> = vec![
         // missing files
-        (vec!["dataset", "info", &p("missing.npz")], vec!["missing.npz"]),
-        (vec!["dataset", "export", &p("missing.npz"), "--csv", "OUT"], vec!["missing.npz"]),
-        (vec!["train", &p("missing.npz"), "--out", "OUT"], vec!["missing.npz"]),
-        (vec!["predict", &p("missing.json"), &p("data.npz"), "--out", "OUT"], vec!["missing.json"]),
-        (vec!["predict", &p("published.json"), "--inputs", &p("missing.csv"), "--out", "OUT"], vec!["missing.csv"]),
-        (vec!["qs", "predict", &p("missing.json"), &p("data.npz"), "--out", "OUT"], vec!["missing.json"]),
-        (vec!["model", "import-published", &p("missing.npz"), "--out", "OUT"], vec!["missing.npz"]),
-        (vec!["train", &p("data.npz"), "--out", "OUT", "--resume"], vec!["OUT_STEM.ckpt.json"]),
+        (
+            vec!["dataset", "info", &p("missing.npz")],
+            vec!["missing.npz"],
+        ),
+        (
+            vec!["dataset", "export", &p("missing.npz"), "--csv", "OUT"],
+            vec!["missing.npz"],
+        ),
+        (
+            vec!["train", &p("missing.npz"), "--out", "OUT"],
+            vec!["missing.npz"],
+        ),
+        (
+            vec![
+                "predict",
+                &p("missing.json"),
+                &p("data.npz"),
+                "--out",
+                "OUT",
+            ],
+            vec!["missing.json"],
+        ),
+        (
+            vec![
+                "predict",
+                &p("published.json"),
+                "--inputs",
+                &p("missing.csv"),
+                "--out",
+                "OUT",
+            ],
+            vec!["missing.csv"],
+        ),
+        (
+            vec![
+                "qs",
+                "predict",
+                &p("missing.json"),
+                &p("data.npz"),
+                "--out",
+                "OUT",
+            ],
+            vec!["missing.json"],
+        ),
+        (
+            vec![
+                "model",
+                "import-published",
+                &p("missing.npz"),
+                "--out",
+                "OUT",
+            ],
+            vec!["missing.npz"],
+        ),
+        (
+            vec!["train", &p("data.npz"), "--out", "OUT", "--resume"],
+            vec!["OUT_STEM.ckpt.json"],
+        ),
         // corrupt files
-        (vec!["dataset", "info", &p("corrupt.npz")], vec!["corrupt.npz", ".npz archive"]),
-        (vec!["qs", "fit", &p("corrupt.npz"), "--out", "OUT"], vec!["corrupt.npz"]),
-        (vec!["predict", &p("truncated.json"), &p("data.npz"), "--out", "OUT"], vec!["truncated.json", "line"]),
-        (vec!["dataset", "import", "--csv", &p("nan.csv"), "--out", "OUT"], vec!["nan.csv", "line"]),
+        (
+            vec!["dataset", "info", &p("corrupt.npz")],
+            vec!["corrupt.npz", ".npz archive"],
+        ),
+        (
+            vec!["qs", "fit", &p("corrupt.npz"), "--out", "OUT"],
+            vec!["corrupt.npz"],
+        ),
+        (
+            vec![
+                "predict",
+                &p("truncated.json"),
+                &p("data.npz"),
+                "--out",
+                "OUT",
+            ],
+            vec!["truncated.json", "line"],
+        ),
+        (
+            vec!["dataset", "import", "--csv", &p("nan.csv"), "--out", "OUT"],
+            vec!["nan.csv", "line 10, column 12 (a_z)", "NaN"],
+        ),
         // wrong kind of file
-        (vec!["train", &p("table.csv"), "--out", "OUT"], vec!["table.csv", ".npz"]),
-        (vec!["dataset", "info", &p("published.json")], vec!["published.json"]),
-        (vec!["predict", &p("foreign.json"), &p("data.npz"), "--out", "OUT"], vec!["foreign.json", "something-else"]),
-        (vec!["qs", "predict", &p("published.json"), &p("data.npz"), "--out", "OUT"], vec!["published.json", "LRQSM"]),
-        (vec!["model", "import-published", &p("data.npz"), "--out", "OUT"], vec!["data.npz", "param_"]),
-        (vec!["predict", &p("published.json"), "--inputs", &p("table.csv"), "--out", "OUT"], vec!["table.csv", "3 columns"]),
+        (
+            vec!["train", &p("table.csv"), "--out", "OUT"],
+            vec!["table.csv", ".npz"],
+        ),
+        (
+            vec!["dataset", "info", &p("published.json")],
+            vec!["published.json"],
+        ),
+        (
+            vec![
+                "predict",
+                &p("foreign.json"),
+                &p("data.npz"),
+                "--out",
+                "OUT",
+            ],
+            vec!["foreign.json", "something-else"],
+        ),
+        (
+            vec![
+                "qs",
+                "predict",
+                &p("published.json"),
+                &p("data.npz"),
+                "--out",
+                "OUT",
+            ],
+            vec!["published.json", "LRQSM"],
+        ),
+        (
+            vec!["model", "import-published", &p("data.npz"), "--out", "OUT"],
+            vec!["data.npz", "param_"],
+        ),
+        (
+            vec![
+                "predict",
+                &p("published.json"),
+                "--inputs",
+                &p("table.csv"),
+                "--out",
+                "OUT",
+            ],
+            vec!["table.csv", "3 columns"],
+        ),
         // nonexistent columns
-        (vec!["qs", "fit-csv", &p("table.csv"), "--targets", "nope", "--out", "OUT"], vec!["table.csv", "nope", "a, b, c"]),
-        (vec!["qs", "fit-csv", &p("table.csv"), "--targets", "c", "--features", "a,zz", "--out", "OUT"], vec!["table.csv", "zz"]),
+        (
+            vec![
+                "qs",
+                "fit-csv",
+                &p("table.csv"),
+                "--targets",
+                "nope",
+                "--out",
+                "OUT",
+            ],
+            vec!["table.csv", "nope", "a, b, c"],
+        ),
+        (
+            vec![
+                "qs",
+                "fit-csv",
+                &p("table.csv"),
+                "--targets",
+                "c",
+                "--features",
+                "a,zz",
+                "--out",
+                "OUT",
+            ],
+            vec!["table.csv", "zz"],
+        ),
         // future version
-        (vec!["predict", &p("future.json"), &p("data.npz"), "--out", "OUT"], vec!["future.json", "version 99"]),
-        (vec!["predict", &p("future.json"), "--inputs", &p("table.csv"), "--out", "OUT"], vec!["future.json", "version 99"]),
+        (
+            vec!["predict", &p("future.json"), &p("data.npz"), "--out", "OUT"],
+            vec!["future.json", "version 99"],
+        ),
+        (
+            vec![
+                "predict",
+                &p("future.json"),
+                "--inputs",
+                &p("table.csv"),
+                "--out",
+                "OUT",
+            ],
+            vec!["future.json", "version 99"],
+        ),
         // no outputs to train on
-        (vec!["train", &p("kin.npz"), "--out", "OUT"], vec!["kin.npz", "no outputs"]),
+        (
+            vec!["train", &p("kin.npz"), "--out", "OUT"],
+            vec!["kin.npz", "no outputs"],
+        ),
     ]
     .into_iter()
     .map(|(a, n)| {
@@ -96,7 +262,10 @@ fn bad_inputs_are_refused_naming_the_file_and_writing_nothing() {
         assert_fails(&o, &needles, &out);
         // Causes are not repeated ("…(os error 2): …(os error 2)").
         let err = String::from_utf8_lossy(&o.stderr);
-        assert!(err.matches("os error").count() <= 1, "case {i} {args:?}: {err}");
+        assert!(
+            err.matches("os error").count() <= 1,
+            "case {i} {args:?}: {err}"
+        );
     }
 }
 
@@ -106,6 +275,7 @@ fn bad_inputs_are_refused_naming_the_file_and_writing_nothing() {
 fn writing_to_a_closed_pipe_ends_quietly() {
     use std::os::unix::process::ExitStatusExt;
     use std::process::{Command, Stdio};
+    let _serial = SPAWN.lock().unwrap_or_else(|e| e.into_inner());
     let tmp = tempfile::tempdir().unwrap();
     let kin = tmp.path().join("kin.npz");
     ok(&["trajectories", "--n", "2", "--out", s(&kin)]);

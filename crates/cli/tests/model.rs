@@ -29,7 +29,10 @@ fn write_inputs(r: &mut NpzReader, path: &Path) {
 
 /// Largest |a − b| over all elements.
 fn max_abs_diff(a: &[f64], b: &[f64]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max)
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max)
 }
 
 /// Our prediction is a sixth independent Monte-Carlo run (30 fresh particles) of the authors'
@@ -100,7 +103,10 @@ fn import_published_then_predict_lies_within_the_authors_run_to_run_spread() {
         ]);
         let (header, rows) = read_csv(&pred);
         assert_eq!(header.len(), 1 + 2 * DY, "{header:?}");
-        assert_eq!((header[1].as_str(), header[6].as_str()), ("mean_0", "var_0"));
+        assert_eq!(
+            (header[1].as_str(), header[6].as_str()),
+            ("mean_0", "var_0")
+        );
         assert_eq!(rows.len(), T);
         for (t, row) in rows.iter().enumerate() {
             assert_eq!(row[0], t as f64);
@@ -170,13 +176,6 @@ fn wrong_input_width_is_refused_naming_the_csv() {
     let csv = dir.path().join("six.csv");
     std::fs::write(&csv, "a,b,c,d,e,f\n0,0,0,0,0,0\n1,1,1,1,1,1\n").unwrap();
     let out = dir.path().join("pred.csv");
-    let o = flapssm(&[
-        "predict",
-        s(&model),
-        "--inputs",
-        s(&csv),
-        "--out",
-        s(&out),
-    ]);
+    let o = flapssm(&["predict", s(&model), "--inputs", s(&csv), "--out", s(&out)]);
     assert_fails(&o, &[s(&csv), "6 columns", "D_u = 7"], &out);
 }

@@ -90,7 +90,9 @@ fn published_model_on_a_dataset_writes_the_documented_arrays() {
         .flat_map(|t| t.outputs.as_ref().unwrap().iter().flatten().copied())
         .collect();
     assert_eq!(y, y_ds);
-    let train: Vec<f64> = (0..n).map(|i| f64::from(u8::from(i < ds.n_train))).collect();
+    let train: Vec<f64> = (0..n)
+        .map(|i| f64::from(u8::from(i < ds.n_train)))
+        .collect();
     assert_eq!(is_train, train);
     assert!(var.iter().chain(&lvar).all(|v| *v > 0.0 && v.is_finite()));
     assert!(mean.iter().chain(&lmean).all(|v| v.is_finite()));
@@ -113,7 +115,10 @@ fn published_model_on_a_dataset_writes_the_documented_arrays() {
         let mut a = args;
         a[7] = s(&again);
         predict_with_threads(threads, &a);
-        assert!(std::fs::read(&again).unwrap() == bytes, "{threads} threads differ");
+        assert!(
+            std::fs::read(&again).unwrap() == bytes,
+            "{threads} threads differ"
+        );
     }
     let other = dir.path().join("other.npz");
     let mut a = args;
@@ -144,7 +149,15 @@ fn published_model_on_a_kinematics_dataset_is_refused() {
 fn zero_particles_is_a_usage_error() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("pred.npz");
-    let o = flapssm(&["predict", "m.json", "d.npz", "--particles", "0", "--out", s(&out)]);
+    let o = flapssm(&[
+        "predict",
+        "m.json",
+        "d.npz",
+        "--particles",
+        "0",
+        "--out",
+        s(&out),
+    ]);
     assert_eq!(o.status.code(), Some(2));
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(err.contains("--particles") && err.contains(">= 1"), "{err}");

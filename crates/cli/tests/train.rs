@@ -91,27 +91,39 @@ fn ctrl_c_then_resume_is_bit_identical_and_the_model_predicts() {
     assert!(step > 0 && step < 300, "interrupted at step {step}");
 
     ok(&[&train_args(&data, &b, EPOCHS)[..], &["--resume"]].concat());
-    for (x, y) in [(a.clone(), b.clone()), (dir.path().join("a.last.json"), dir.path().join("b.last.json"))] {
-        let (mx, my) = (json(&x)["model"].clone(), json(&y)["model"].clone());
-        assert!(
-            mx["params"] == my["params"],
-            "{} and {} differ",
-            x.display(),
-            y.display()
-        );
-        assert_eq!(mx["training"]["history"], my["training"]["history"]);
+    for (x, y) in [
+        (a.clone(), b.clone()),
+        (
+            dir.path().join("a.last.json"),
+            dir.path().join("b.last.json"),
+        ),
+    ] {
+        let (fx, fy) = (std::fs::read(&x).unwrap(), std::fs::read(&y).unwrap());
+        assert!(fx == fy, "{} and {} differ", x.display(), y.display());
     }
     let history = json(&b)["model"]["training"]["history"].clone();
     assert_eq!(history.as_array().unwrap().len(), 60);
 
     let model = PrssmModel::load(&b).unwrap();
     assert_eq!(
-        (model.config.n_state, model.config.n_inducing, model.config.n_input),
+        (
+            model.config.n_state,
+            model.config.n_inducing,
+            model.config.n_input
+        ),
         (5, 10, 7)
     );
     assert!(model.normalization.is_some());
     let pred = dir.path().join("pred.npz");
-    ok(&["predict", s(&b), s(&data), "--particles", "4", "--out", s(&pred)]);
+    ok(&[
+        "predict",
+        s(&b),
+        s(&data),
+        "--particles",
+        "4",
+        "--out",
+        s(&pred),
+    ]);
     let mean = flapssm_data::npz::NpzReader::open(&pred)
         .unwrap()
         .f64_shaped("output_mean", &[12, 470, 5])
@@ -124,11 +136,11 @@ fn resuming_with_another_configuration_is_refused_naming_the_field() {
     let dir = tempfile::tempdir().unwrap();
     let data = simulated(dir.path(), 6, 1);
     let first = dir.path().join("m.json");
-    ok(&train_args(&data, &first, "2"));
+    ok(&train_args(&data, &first, "5"));
     let ckpt = dir.path().join("m.ckpt.json");
     assert!(ckpt.exists());
     let out = dir.path().join("n.json");
-    let mut args = train_args(&data, &out, "2");
+    let mut args = train_args(&data, &out, "5");
     args.extend(["--lr", "0.01", "--resume", "--checkpoint", s(&ckpt)]);
     let o = flapssm(&args);
     assert_fails(&o, &["lr", "0.01", s(&data)], &out);

@@ -57,7 +57,15 @@ fn bad_arguments_are_refused_and_write_nothing() {
     let out = dir.path().join("t.npz");
     let o = flapssm(&["trajectories", "--n", "0", "--out", s(&out)]);
     assert_fails(&o, &["n_trajectories", "0"], &out);
-    let o = flapssm(&["trajectories", "--n", "4", "--n-train", "5", "--out", s(&out)]);
+    let o = flapssm(&[
+        "trajectories",
+        "--n",
+        "4",
+        "--n-train",
+        "5",
+        "--out",
+        s(&out),
+    ]);
     assert_fails(&o, &["n_train", "5"], &out);
     let missing = dir.path().join("no/such/dir/t.npz");
     let o = flapssm(&["trajectories", "--n", "2", "--out", s(&missing)]);

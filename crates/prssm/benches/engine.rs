@@ -6,9 +6,10 @@
 //!   (plus the per-evaluation K_mm factorization and KL);
 //! - `predict/len470_p30`: one 470-step open-loop prediction with 30 particles (one thread).
 //!
-//! Run: `cargo bench -p flapssm-prssm --bench engine`. The projected epoch time is printed,
-//! from wall time and from CPU time (the latter is what idle cores would give on a shared,
-//! loaded machine).
+//! Run: `cargo bench -p flapssm-prssm --bench engine` (`-- zzz` skips the criterion groups
+//! and prints only the projections). The projected epoch time is printed from wall time and
+//! from CPU time (the latter is what idle cores would give on a shared, loaded machine), and
+//! the CPU time of one prediction. `WPT=<n>` sets `windows_per_task` (default 8).
 
 use std::hint::black_box;
 use std::time::Instant;

@@ -692,12 +692,17 @@ impl GeneratorConfig {
         let dev_amp = |rng: &mut ChaCha8Rng, lo: f64| rng.random_range(lo.min(max_dev)..=max_dev);
         match family {
             Family::FigureEight => {
+                // Tip rises through both reversals (ψ̇ > 0 while the pitch flips through α = 0,
+                // leading edge up), so the leading edge keeps leading.
                 let a = dev_amp(rng, 8.0 * DEG).min(0.5 * amp);
-                dev.add_sin(2, a, rng.random_range(-0.5..0.5));
+                dev.add_sin(2, -a, rng.random_range(-0.5..0.5));
             }
             Family::UShaped => {
-                let a = dev_amp(rng, 8.0 * DEG).min(0.5 * amp);
-                dev.add_cos(2, -a, rng.random_range(-0.3..0.3));
+                // Ψ ≤ 0.3Φ keeps the descent after the reversal shallower than ~30°, which the
+                // pitch rotation can follow with the leading edge first.
+                let a = dev_amp(rng, 8.0 * DEG).min(0.3 * amp);
+                // Highest point at or just after the reversal: ψ̇ ≥ 0 during the flip.
+                dev.add_cos(2, -a, rng.random_range(-0.4..0.0));
             }
             Family::Oval => {
                 let a = dev_amp(rng, 8.0 * DEG).min(0.5 * amp);

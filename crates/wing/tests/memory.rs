@@ -7,10 +7,11 @@
 //!   cross-correlation between a_x and the quasi-steady residual of F_x peaks 0.1–0.3 cycle
 //!   later.
 //!
-//! The trajectories have a flat stroke plane (ψ = 0). With deviation (default generator,
-//! ψ ≤ 40°) about a quarter of the samples move trailing-edge first and ω_z = α̇ + φ̇ sin ψ ≠ α̇,
-//! which the 11 features cannot represent: L0 then reaches only 0.26 and the L1 ratio is 1.43
-//! (see docs/virtual-wing.md).
+//! Both targets hold with a flat stroke plane (ψ = 0). On the default generator (ψ ≤ 40°) only
+//! the lag target holds: ω_z = α̇ + φ̇ sin ψ ≠ α̇, the trailing edge leads in ~6 % of the
+//! |v|²-weight (near reversals), and the 11 features cannot represent either, so L0 is fit only
+//! to ≈ 0.19 and the L1 ratio is ≈ 1.1. Those tests pin the measured values with a margin
+//! (see docs/virtual-wing.md); they are regression guards, not the issue-3 targets.
 
 use faer::Mat;
 use faer::linalg::solvers::Solve;
@@ -30,14 +31,15 @@ const LAGS: [usize; 20] = [
     0, 1, 2, 3, 4, 6, 8, 10, 13, 16, 20, 25, 30, 36, 43, 50, 60, 70, 85, 100,
 ];
 
-/// Small noise-free dataset with a flat stroke plane (deviation ψ = 0; see the module docs).
-fn dataset(fidelity: Fidelity) -> (Dataset, Vec<f64>) {
+/// Small noise-free dataset: default generator, or a flat stroke plane (ψ = 0) if `flat`.
+fn dataset(fidelity: Fidelity, flat: bool) -> (Dataset, Vec<f64>) {
+    let defaults = GeneratorConfig::default();
     let trajectories = GeneratorConfig {
         n_trajectories: N_TRAJ,
         n_train: N_TRAIN,
         seed: SEED,
-        max_deviation_deg: 0.0,
-        ..Default::default()
+        max_deviation_deg: if flat { 0.0 } else { defaults.max_deviation_deg },
+        ..defaults
     };
     let freqs = trajectories
         .generate()
@@ -221,37 +223,86 @@ fn median(mut v: Vec<f64>) -> f64 {
     v[v.len() / 2]
 }
 
-#[test]
-fn quasi_steady_data_are_fit_by_the_quasi_steady_features() {
-    let (ds, _) = dataset(Fidelity::L0);
-    let qs = fit(&ds, false);
-    eprintln!(
-        "L0: QS test RMSE = {:.4} {:?}",
-        qs.test_rmse, qs.channel_rmse
-    );
-    assert!(qs.test_rmse < 0.1, "L0 QS test RMSE {}", qs.test_rmse);
+struct Memory {
+    qs_l0: f64,
+    qs_l1: f64,
+    history_l1: f64,
+    median_lag_cycles: f64,
 }
 
-#[test]
-fn unsteady_data_need_history() {
-    let (ds, freqs) = dataset(Fidelity::L1);
+fn memory(flat: bool) -> Memory {
+    let label = if flat { "flat" } else { "default" };
+    let (ds0, _) = dataset(Fidelity::L0, flat);
+    let l0 = fit(&ds0, false);
+    let (ds, freqs) = dataset(Fidelity::L1, flat);
     let qs = fit(&ds, false);
     let hist = fit(&ds, true);
-    let lags = xcorr_peak_lags(&ds, &freqs, &qs.residual_fx);
-    let lag = median(lags.clone());
+    let median_lag_cycles = median(xcorr_peak_lags(&ds, &freqs, &qs.residual_fx));
     eprintln!(
-        "L1: QS test RMSE = {:.4} {:?}, history model = {:.4} {:?}, ratio = {:.2}, median a_x→residual lag = {:.3} cycle",
+        "{label}: L0 QS test RMSE = {:.4} {:?}\n{label}: L1 QS = {:.4} {:?}, history model = {:.4} {:?}, ratio = {:.2}, median a_x→residual lag = {:.3} cycle",
+        l0.test_rmse,
+        l0.channel_rmse,
         qs.test_rmse,
         qs.channel_rmse,
         hist.test_rmse,
         hist.channel_rmse,
         qs.test_rmse / hist.test_rmse,
-        lag
+        median_lag_cycles
     );
-    assert!(
-        qs.test_rmse >= 2.0 * hist.test_rmse,
-        "ratio {}",
-        qs.test_rmse / hist.test_rmse
-    );
+    Memory {
+        qs_l0: l0.test_rmse,
+        qs_l1: qs.test_rmse,
+        history_l1: hist.test_rmse,
+        median_lag_cycles,
+    }
+}
+
+#[test]
+fn flat_stroke_plane_meets_the_memory_targets() {
+    let m = memory(true);
+    assert!(m.qs_l0 < 0.1, "L0 QS test RMSE {}", m.qs_l0);
+    let ratio = m.qs_l1 / m.history_l1;
+    assert!(ratio >= 2.0, "ratio {ratio}");
+    let lag = m.median_lag_cycles;
     assert!((0.1..=0.3).contains(&lag), "median lag {lag} cycle");
+}
+
+/// Default generator: the lag target holds; L0 and the ratio are pinned at their measured
+/// values (0.185, 1.08) with a margin — they fall short of the targets (< 0.1, ≥ 2).
+#[test]
+fn default_trajectories_memory_evidence() {
+    let m = memory(false);
+    let lag = m.median_lag_cycles;
+    assert!((0.1..=0.3).contains(&lag), "median lag {lag} cycle");
+    assert!(m.qs_l0 < 0.21, "L0 QS test RMSE {}", m.qs_l0);
+    assert!(m.qs_l1 > 1.4 * m.qs_l0, "L1 QS {} vs L0 QS {}", m.qs_l1, m.qs_l0);
+    let ratio = m.qs_l1 / m.history_l1;
+    assert!(ratio > 1.0, "ratio {ratio}");
+}
+
+/// The trailing edge leads (|AoA| > 90°) in only a small share of the |v|²-weight of the
+/// default generator's analysed samples (measured 6–7 %; before the issue-3 generator fix
+/// 17–18 %, mostly figure-eight trajectories descending through the reversals).
+#[test]
+fn default_trajectories_move_leading_edge_first() {
+    let cfg = GeneratorConfig {
+        n_trajectories: 200,
+        n_train: 190,
+        seed: SEED,
+        ..Default::default()
+    };
+    let ds = flapssm_wing::trajectories::kinematics_dataset(&cfg).unwrap();
+    let (mut te, mut all) = (0.0, 0.0);
+    for t in &ds.trajectories {
+        for u in &t.inputs[93..] {
+            let w = u[1] * u[1];
+            all += w;
+            if u[0].abs() > std::f64::consts::FRAC_PI_2 {
+                te += w;
+            }
+        }
+    }
+    let share = te / all;
+    eprintln!("TE-first share of |v|²-weight: {:.3}", share);
+    assert!(share < 0.09, "TE-first share {share}");
 }

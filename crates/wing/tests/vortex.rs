@@ -91,6 +91,7 @@ fn wagner_step_response() {
 }
 
 /// Complex amplitude (a, b) of x ≈ a cos ωt + b sin ωt + d, least squares.
+#[allow(clippy::needless_range_loop)]
 fn harmonic_fit(t: &[f64], x: &[f64], w: f64) -> (f64, f64) {
     let mut ata = [[0.0; 3]; 3];
     let mut atb = [0.0; 3];
@@ -341,30 +342,34 @@ fn eldredge_pitch_up_lift_during_ramp() {
             peak = (cl[i], t);
         }
     }
-    let during: Vec<f64> = r
-        .t
-        .iter()
-        .zip(&cl)
-        .filter(|(t, _)| **t > t_on + 0.1 && **t < ELDREDGE_T2)
-        .map(|(_, c)| *c)
-        .collect();
+    let during: Vec<f64> =
+        r.t.iter()
+            .zip(&cl)
+            .filter(|(t, _)| **t > t_on + 0.1 && **t < ELDREDGE_T2)
+            .map(|(_, c)| *c)
+            .collect();
     let min_during = during.iter().cloned().fold(f64::INFINITY, f64::min);
-    let after: Vec<f64> = r
-        .t
-        .iter()
-        .zip(&cl)
-        .filter(|(t, _)| **t > ELDREDGE_T2 + 0.5)
-        .map(|(_, c)| *c)
-        .collect();
+    let after: Vec<f64> =
+        r.t.iter()
+            .zip(&cl)
+            .filter(|(t, _)| **t > ELDREDGE_T2 + 0.5)
+            .map(|(_, c)| *c)
+            .collect();
     let mean_after = after.iter().sum::<f64>() / after.len() as f64;
     println!(
         "smoothed C_L: peak {:.2} at t* = {:.3} (ramp ends at {ELDREDGE_T2:.3}), min during ramp {min_during:.2}, mean after {mean_after:.2}; max |pressure − impulse| {worst_rel:.3}",
         peak.0, peak.1
     );
     assert!(worst_rel < 0.15, "pressure vs impulse lift: {worst_rel}");
-    assert!(min_during > 2.0, "lift collapses during the ramp: {min_during}");
+    assert!(
+        min_during > 2.0,
+        "lift collapses during the ramp: {min_during}"
+    );
     assert!(peak.1 < ELDREDGE_T2 + 0.1, "peak at t* = {}", peak.1);
-    assert!((2.0..=4.0).contains(&mean_after), "C_L after the ramp: {mean_after}");
+    assert!(
+        (2.0..=4.0).contains(&mean_after),
+        "C_L after the ramp: {mean_after}"
+    );
 }
 
 /// 2-D hovering: surge ±A along X with the LE leading, 45° geometric AoA at mid-stroke, a 2ω

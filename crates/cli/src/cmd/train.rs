@@ -127,7 +127,8 @@ pub fn run(args: TrainArgs) -> anyhow::Result<()> {
     if !(0.0..1.0).contains(&args.val_fraction) {
         bail!("--val-fraction {} must be in [0, 1)", args.val_fraction);
     }
-    let n_val = ((all.len() as f64 * args.val_fraction).round() as usize).min(all.len().saturating_sub(1));
+    let n_val =
+        ((all.len() as f64 * args.val_fraction).round() as usize).min(all.len().saturating_sub(1));
     let (train_seqs, val_seqs) = all.split_at(all.len() - n_val);
     if train_seqs.is_empty() {
         bail!("{}: no training trajectories", args.dataset.display());

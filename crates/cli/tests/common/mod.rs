@@ -30,7 +30,9 @@ pub fn s(p: &Path) -> &str {
 
 /// The shared reference directory `shared/reference/<name>`.
 pub fn reference(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/reference").join(name)
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../../shared/reference")
+        .join(name)
 }
 
 /// Asserts exit code 1 (not a panic, not a usage error), a message on stderr containing

@@ -22,7 +22,8 @@
 //! the leading-edge suction parameter is LESP = A0 = B0/U_ref.
 //!
 //! Each step: (1) convect the free vortices with the velocities of the previous step (forward
-//! Euler, Vatistas n = 2 core r_c), (2) decay, delete and amalgamate them, (3) place a new
+//! Euler, Vatistas n = 2 core r_c between free vortices, the exact velocity of the truncated
+//! bound sheet from the conformal map, vortices that would cross the plate mirrored back), (2) decay, delete and amalgamate them, (3) place a new
 //! trailing-edge vortex (TEV) 1/3 of the way from the trailing edge to the previous TEV and solve
 //! Kelvin's condition Γ_bound + Σ Γ_free = 0 for its strength, (4) if |LESP| > LESP_crit also place
 //! a leading-edge vortex (LEV) and solve the 2×2 system {Kelvin, B0 = ±LESP_crit·U_ref} for both
@@ -34,7 +35,13 @@
 //! chord; V_t = −V_p·t̂ is the chordwise speed of the oncoming flow, u_t,j the chordwise velocity
 //! induced by the free vortices at bound element j, Γ_j its clockwise circulation):
 //!
-//! N' = ρ[V_t cπ(B0 + B1/2) + Σ_j u_t,j Γ_j] + ρπc² (¾Ḃ0 + ¼Ḃ1 + ⅛Ḃ2)                  (along n̂)
+//! N' = ρ[V_t cπ(B0 + B1/2) + Σ_j u_t,j Γ_j] + ρπc² (¾Ḃ0 + ¼Ḃ1 + ⅛Ḃ2) − ρc Γ_LEV/Δt  (along n̂)
+//!
+//! The last term is the potential jump carried by the LE feeding sheet: circulation shed at the
+//! LE stays connected to it, so the jump across the plate is ∫₀ˣγ dξ + Σ Γ_LEV,cw, not ∫₀ˣγ dξ
+//! alone (UNSflow omits it). With it, N' equals the force −dI/dt from the vortex impulse (tested);
+//! without it the lift collapses whenever LEVs are shed. The moment gets the same uniform jump:
+//! −ρcΓ_LEV/Δt · c/2 about the LE.
 //!
 //! S' = ρπc B0²  (leading-edge suction, along −t̂, times `suction_factor`)
 //!
