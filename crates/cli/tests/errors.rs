@@ -269,25 +269,39 @@ fn bad_inputs_are_refused_naming_the_file_and_writing_nothing() {
     }
 }
 
-/// `flapssm dataset info FILE | head -0`: the reader is gone before anything is written.
+/// `flapssm qs fit DATA --json | head -c 100`: the model JSON (≈ 400 kB, more than a pipe
+/// holds) meets a closed pipe; the process must end by SIGPIPE, not panic in `println!`.
 #[cfg(unix)]
 #[test]
 fn writing_to_a_closed_pipe_ends_quietly() {
+    use std::io::Read;
     use std::os::unix::process::ExitStatusExt;
     use std::process::{Command, Stdio};
     let _serial = SPAWN.lock().unwrap_or_else(|e| e.into_inner());
     let tmp = tempfile::tempdir().unwrap();
-    let kin = tmp.path().join("kin.npz");
-    ok(&["trajectories", "--n", "2", "--out", s(&kin)]);
+    let data = simulated(tmp.path(), 2, 0);
+    let model = tmp.path().join("q.json");
     let mut child = Command::new(env!("CARGO_BIN_EXE_flapssm"))
-        .args(["dataset", "info", s(&kin)])
+        .args([
+            "qs",
+            "fit",
+            s(&data),
+            "--folds",
+            "3",
+            "--json",
+            "--out",
+            s(&model),
+        ])
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
         .unwrap();
-    drop(child.stdout.take());
+    let mut head = [0u8; 100];
+    child.stdout.take().unwrap().read_exact(&mut head).unwrap();
     let o = child.wait_with_output().unwrap();
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(!err.contains("panicked"), "{err}");
     assert_eq!(o.status.signal(), Some(13), "status {:?}: {err}", o.status);
+    assert!(String::from_utf8_lossy(&head).contains("flapssm-lrqsm"));
+    assert!(model.exists());
 }

@@ -555,3 +555,133 @@ impl ConditionalWorkspace {
         );
     }
 }
+
+/// Forward-only conditional for prediction (no derivatives, no tape). `W` and the means come
+/// from one product `[W; μ] = [G; mᵀG] K` (`(M + D_x) × N`); `σ²` as in [`ConditionalWorkspace`].
+#[derive(Debug, Clone)]
+pub(crate) struct PredictiveWorkspace {
+    cap: usize,
+    group: usize,
+    /// `[G; mᵀG]`, column-major `(M + D_x) × M`.
+    g_mean: Vec<f64>,
+    /// GP inputs `[x; u]`, column-major `D × N` (filled by the caller).
+    pub input: Vec<f64>,
+    xs: Vec<f64>,
+    k: Vec<f64>,
+    /// `[W; μ]`, column-major `(M + D_x) × N`.
+    wm: Vec<f64>,
+    w2: Vec<f64>,
+    tau_shared: Vec<f64>,
+    /// Variances `σ²`, column-major `D_x × N`.
+    pub var: Vec<f64>,
+}
+
+impl PredictiveWorkspace {
+    /// Buffers for up to `capacity` points whose consecutive groups of `group` share the
+    /// input part `u` (see [`ConditionalWorkspace::set_input_group`]).
+    pub(crate) fn new(post: &Posterior, capacity: usize, group: usize) -> Self {
+        let (m, d, dx, n) = (post.m, post.d, post.dx, capacity);
+        let mut mg = vec![0.0; dx * m];
+        gemm(
+            view_mut(&mut mg, dx, m),
+            Accum::Replace,
+            view(&post.q_mean, dx, m),
+            view(&post.g, m, m),
+            1.0,
+        );
+        let mut g_mean = vec![0.0; (m + dx) * m];
+        for j in 0..m {
+            let col = &mut g_mean[j * (m + dx)..(j + 1) * (m + dx)];
+            col[..m].copy_from_slice(&post.g[j * m..(j + 1) * m]);
+            col[m..].copy_from_slice(&mg[j * dx..(j + 1) * dx]);
+        }
+        Self {
+            cap: n,
+            group: group.max(1),
+            g_mean,
+            input: vec![0.0; d * n],
+            xs: vec![0.0; d * n],
+            k: vec![0.0; m * n],
+            wm: vec![0.0; (m + dx) * n],
+            w2: vec![0.0; m * n],
+            tau_shared: vec![0.0; m],
+            var: vec![0.0; dx * n],
+        }
+    }
+
+    /// Means `μ` of the last [`Self::forward`]: column `n` is `mean(n)` (`D_x` values).
+    #[inline]
+    pub(crate) fn mean(&self, post: &Posterior, n: usize) -> &[f64] {
+        let r = post.m + post.dx;
+        &self.wm[n * r + post.m..(n + 1) * r]
+    }
+
+    /// Computes `μ` and `σ²` at the first `n` columns of [`Self::input`]. Allocates nothing.
+    pub(crate) fn forward(&mut self, post: &Posterior, n: usize) {
+        let (m, d, dx) = (post.m, post.d, post.dx);
+        debug_assert!(n <= self.cap);
+        let r = m + dx;
+        kernel::scale_points(&self.input[..d * n], &post.inv_len, &mut self.xs[..d * n]);
+        kernel::cross_cov_grouped_values(
+            post.kind,
+            post.variance,
+            post.tau_jitter,
+            &post.zt,
+            &self.xs[..d * n],
+            d,
+            (dx, self.group),
+            &mut self.k[..m * n],
+            &mut self.tau_shared,
+        );
+        gemm(
+            view_mut(&mut self.wm, r, n),
+            Accum::Replace,
+            view(&self.g_mean, r, m),
+            view(&self.k, m, n),
+            1.0,
+        );
+        let w = view(&self.wm, r, n).subrows(0, m);
+        match post.cov {
+            CovarianceStructure::Diagonal => {
+                for (w2, wc) in self.w2[..m * n].chunks_exact_mut(m).zip(self.wm.chunks(r)) {
+                    w2.iter_mut().zip(&wc[..m]).for_each(|(a, &b)| *a = b * b);
+                }
+                gemm(
+                    view_mut(&mut self.var, dx, n),
+                    Accum::Replace,
+                    view(&post.q_cov, dx, m),
+                    view(&self.w2, m, n),
+                    1.0,
+                )
+            }
+            CovarianceStructure::Full => {
+                for dd in 0..dx {
+                    let ld = &post.q_cov[dd * m * m..(dd + 1) * m * m];
+                    gemm(
+                        view_mut(&mut self.w2, m, n),
+                        Accum::Replace,
+                        view(ld, m, m).transpose(),
+                        w,
+                        1.0,
+                    );
+                    for j in 0..n {
+                        let c = &self.w2[j * m..(j + 1) * m];
+                        self.var[j * dx + dd] = dot(c, c);
+                    }
+                }
+            }
+        }
+        for j in 0..n {
+            let wc = &self.wm[j * r..j * r + m];
+            let hc = if post.whitened {
+                wc
+            } else {
+                &self.k[j * m..(j + 1) * m]
+            };
+            let base = post.variance - dot(wc, hc);
+            self.var[j * dx..(j + 1) * dx]
+                .iter_mut()
+                .for_each(|v| *v += base);
+        }
+    }
+}

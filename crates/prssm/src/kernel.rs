@@ -175,6 +175,30 @@ pub(crate) fn cross_cov_grouped(
     }
 }
 
+/// Forward-only [`cross_cov_grouped`]: `K` without the derivative (prediction).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn cross_cov_grouped_values(
+    kind: KernelKind,
+    variance: f64,
+    matern_tau_jitter: f64,
+    zt: &[f64],
+    xs: &[f64],
+    d: usize,
+    (shared_from, group): (usize, usize),
+    k: &mut [f64],
+    tau_shared: &mut [f64],
+) {
+    let m_n = zt.len() / d;
+    let tau_shared = &mut tau_shared[..m_n];
+    for (kg, xg) in k.chunks_mut(m_n * group).zip(xs.chunks(d * group)) {
+        sq_dist(zt, m_n, shared_from, &xg[shared_from..d], None, tau_shared);
+        for (kc, x) in kg.chunks_exact_mut(m_n).zip(xg.chunks_exact(d)) {
+            sq_dist(zt, m_n, 0, &x[..shared_from], Some(tau_shared), kc);
+            apply_shape_values(kind, variance, matern_tau_jitter, kc);
+        }
+    }
+}
+
 /// `out[m] = init[m] + Σ_j (z̃_{m, j0+j} − x_j)²` for all `M` inducing points, in SIMD
 /// register blocks (`zt` dimension-major with stride `m_n`).
 #[inline(always)]
@@ -241,6 +265,24 @@ fn apply_shape(kind: KernelKind, variance: f64, jitter: f64, k: &mut [f64], kd: 
                 let g = variance * exp(-0.5 * *kv);
                 *kv = g;
                 *kdv = -0.5 * g;
+            }
+        }
+    }
+}
+
+/// Replaces `τ` in `k` by `σ_f² g(τ)` (no derivative).
+#[inline]
+fn apply_shape_values(kind: KernelKind, variance: f64, jitter: f64, k: &mut [f64]) {
+    match kind {
+        KernelKind::Matern32 => {
+            for kv in k.iter_mut() {
+                let r = (3.0 * (*kv + jitter)).sqrt();
+                *kv = (1.0 + r) * (variance * exp(-r));
+            }
+        }
+        KernelKind::SquaredExponential => {
+            for kv in k.iter_mut() {
+                *kv = variance * exp(-0.5 * *kv);
             }
         }
     }

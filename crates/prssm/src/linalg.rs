@@ -85,26 +85,24 @@ pub(crate) fn solve_lower_transpose(l: &[f64], m: usize, b: &mut [f64], n: usize
 /// # Errors
 /// `Err(index)`: the pivot `index` is not positive (or not finite).
 pub fn cholesky_in_place(a: &mut [f64], n: usize) -> Result<(), usize> {
+    // Left-looking by columns: `a[j.., j] −= L[j, k] · L[j.., k]` for `k < j` (contiguous
+    // axpys, same summation order as the scalar dot-product form).
     for j in 0..n {
-        let mut d = a[j * n + j];
+        let (done, rest) = a.split_at_mut(j * n);
+        let col = &mut rest[j..n];
         for k in 0..j {
-            d -= a[k * n + j] * a[k * n + j];
+            let lk = &done[k * n + j..(k + 1) * n];
+            let ljk = lk[0];
+            col.iter_mut().zip(lk).for_each(|(c, &l)| *c -= l * ljk);
         }
+        let d = col[0];
         if !(d > 0.0 && d.is_finite()) {
             return Err(j);
         }
         let djj = d.sqrt();
-        a[j * n + j] = djj;
-        for i in j + 1..n {
-            let mut s = a[j * n + i];
-            for k in 0..j {
-                s -= a[k * n + i] * a[k * n + j];
-            }
-            a[j * n + i] = s / djj;
-        }
-        for i in 0..j {
-            a[j * n + i] = 0.0;
-        }
+        col[0] = djj;
+        col[1..].iter_mut().for_each(|c| *c /= djj);
+        rest[..j].fill(0.0);
     }
     Ok(())
 }

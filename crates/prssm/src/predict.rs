@@ -9,7 +9,7 @@ use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
 use serde::{Deserialize, Serialize};
 
-use crate::conditional::{ConditionalWorkspace, Posterior};
+use crate::conditional::{Posterior, PredictiveWorkspace};
 use crate::objective::ObjectiveError;
 use crate::params::{ModelConfig, Params};
 
@@ -30,7 +30,7 @@ pub struct Prediction {
 #[derive(Debug, Clone)]
 pub struct StepPredictor {
     post: Posterior,
-    ws: ConditionalWorkspace,
+    ws: PredictiveWorkspace,
     particles: usize,
     dx: usize,
     du: usize,
@@ -59,9 +59,8 @@ impl StepPredictor {
             return Err(ObjectiveError::Shape("particles must be ≥ 1".into()));
         }
         let post = Posterior::new(config, params)?;
-        let mut ws = ConditionalWorkspace::new(&post, particles);
         // All particles share the input of a step.
-        ws.set_input_group(particles);
+        let ws = PredictiveWorkspace::new(&post, particles, particles);
         Ok(Self {
             post,
             ws,
@@ -100,10 +99,11 @@ impl StepPredictor {
         }
         self.ws.forward(&self.post, self.particles);
         for c in 0..self.particles {
+            let mean = self.ws.mean(&self.post, c);
             for dd in 0..dx {
                 let i = c * dx + dd;
                 let sd = (self.ws.var[i] + self.process_noise_var[dd] + self.jitter).sqrt();
-                x[i] += self.ws.mean[i] + sd * eps[i];
+                x[i] += mean[dd] + sd * eps[i];
             }
         }
     }

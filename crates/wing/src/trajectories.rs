@@ -11,8 +11,8 @@
 //!
 //! | family | deviation ψ |
 //! |---|---|
-//! | figure-eight | Ψ sin(2x + p), tip path crosses itself |
-//! | u-shaped | −Ψ cos(2x + p) (tip rises at both reversals) |
+//! | figure-eight | −Ψ sin(2x + p), tip path crosses itself, tip rising through the reversals |
+//! | u-shaped | −Ψ cos(2x + p), p ∈ [−0.4, 0], Ψ ≤ 0.3Φ (highest at or just after each reversal) |
 //! | oval | Ψ cos(x + p) (the two half-strokes at different heights) |
 //! | flat | |ψ| ≤ 3° |
 //! | harmonic | random harmonics 1–3, half peak-to-peak 5–40° (and random harmonics on φ and α) |

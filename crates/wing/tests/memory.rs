@@ -38,7 +38,11 @@ fn dataset(fidelity: Fidelity, flat: bool) -> (Dataset, Vec<f64>) {
         n_trajectories: N_TRAJ,
         n_train: N_TRAIN,
         seed: SEED,
-        max_deviation_deg: if flat { 0.0 } else { defaults.max_deviation_deg },
+        max_deviation_deg: if flat {
+            0.0
+        } else {
+            defaults.max_deviation_deg
+        },
         ..defaults
     };
     let freqs = trajectories
@@ -275,7 +279,12 @@ fn default_trajectories_memory_evidence() {
     let lag = m.median_lag_cycles;
     assert!((0.1..=0.3).contains(&lag), "median lag {lag} cycle");
     assert!(m.qs_l0 < 0.21, "L0 QS test RMSE {}", m.qs_l0);
-    assert!(m.qs_l1 > 1.4 * m.qs_l0, "L1 QS {} vs L0 QS {}", m.qs_l1, m.qs_l0);
+    assert!(
+        m.qs_l1 > 1.4 * m.qs_l0,
+        "L1 QS {} vs L0 QS {}",
+        m.qs_l1,
+        m.qs_l0
+    );
     let ratio = m.qs_l1 / m.history_l1;
     assert!(ratio > 1.0, "ratio {ratio}");
 }
