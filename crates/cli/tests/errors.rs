@@ -5,7 +5,6 @@
 mod common;
 
 use std::path::Path;
-use std::sync::Mutex;
 
 use common::{assert_fails, flapssm, ok, reference, s, simulated};
 
@@ -51,13 +50,8 @@ fn fixtures(dir: &Path) {
     w("nan.csv", &(lines.join("\n") + "\n"));
 }
 
-/// Serializes the tests of this file: a process spawned by one test while the other holds
-/// an open pipe would inherit the pipe's read end for a moment and keep it alive.
-static SPAWN: Mutex<()> = Mutex::new(());
-
 #[test]
 fn bad_inputs_are_refused_naming_the_file_and_writing_nothing() {
-    let _serial = SPAWN.lock().unwrap_or_else(|e| e.into_inner());
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path();
     fixtures(dir);
@@ -277,7 +271,6 @@ fn writing_to_a_closed_pipe_ends_quietly() {
     use std::io::Read;
     use std::os::unix::process::ExitStatusExt;
     use std::process::{Command, Stdio};
-    let _serial = SPAWN.lock().unwrap_or_else(|e| e.into_inner());
     let tmp = tempfile::tempdir().unwrap();
     let data = simulated(tmp.path(), 2, 0);
     let model = tmp.path().join("q.json");

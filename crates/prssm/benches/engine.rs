@@ -9,7 +9,8 @@
 //! Run: `cargo bench -p flapssm-prssm --bench engine` (`-- zzz` skips the criterion groups
 //! and prints only the projections). The projected epoch time is printed from wall time and
 //! from CPU time (the latter is what idle cores would give on a shared, loaded machine), and
-//! the CPU time of one prediction. `WPT=<n>` sets `windows_per_task` (default 8).
+//! the CPU time of one prediction. `WPT=<n>` sets `windows_per_task` (default 8);
+//! `PREDICT_ONLY=1` skips the minibatch projection (for profiling the prediction).
 
 use std::hint::black_box;
 use std::time::Instant;
@@ -72,6 +73,13 @@ fn cpu_seconds() -> Option<f64> {
 
 fn bench(c: &mut Criterion) {
     let (elbo, theta, config, params, u) = setup();
+    if std::env::var_os("PREDICT_ONLY").is_none() {
+        bench_elbo(c, &elbo, &theta);
+    }
+    bench_predict(c, &config, &params, &u);
+}
+
+fn bench_elbo(c: &mut Criterion, elbo: &Elbo, theta: &[f64]) {
     let mut grad = vec![0.0; theta.len()];
     let mut g = c.benchmark_group("elbo");
     g.sample_size(10);
@@ -85,7 +93,7 @@ fn bench(c: &mut Criterion) {
             .collect();
         g.bench_with_input(BenchmarkId::new("batch16_len", len), &batch, |b, batch| {
             b.iter(|| {
-                elbo.loss_and_grad(black_box(&theta), batch, 7, &mut grad)
+                elbo.loss_and_grad(black_box(theta), batch, 7, &mut grad)
                     .unwrap()
             })
         });
@@ -99,12 +107,12 @@ fn bench(c: &mut Criterion) {
             len: T,
         })
         .collect();
-    elbo.loss_and_grad(&theta, &batch, 99, &mut grad).unwrap();
+    elbo.loss_and_grad(theta, &batch, 99, &mut grad).unwrap();
     let cpu0 = cpu_seconds();
     let mut times: Vec<f64> = (0..5)
         .map(|i| {
             let t0 = Instant::now();
-            elbo.loss_and_grad(&theta, &batch, i, &mut grad).unwrap();
+            elbo.loss_and_grad(theta, &batch, i, &mut grad).unwrap();
             t0.elapsed().as_secs_f64()
         })
         .collect();
@@ -128,12 +136,15 @@ fn bench(c: &mut Criterion) {
             step_flops(480) * (T - 1) as f64 / cpu / 1e9
         );
     }
+}
+
+fn bench_predict(c: &mut Criterion, config: &ModelConfig, params: &Params, u: &[f64]) {
     let zero = vec![0.0; 12];
     let reps = 100;
     let cpu0 = cpu_seconds();
     let t0 = Instant::now();
     for i in 0..reps {
-        black_box(predict(&config, &params, &u, &zero, &zero, 30, i).unwrap());
+        black_box(predict(config, params, u, &zero, &zero, 30, i).unwrap());
     }
     let wall = t0.elapsed().as_secs_f64() / reps as f64;
     if let Some(cpu) = cpu_seconds().zip(cpu0).map(|(a, b)| (a - b) / reps as f64) {
@@ -147,7 +158,7 @@ fn bench(c: &mut Criterion) {
     }
     let mut g = c.benchmark_group("predict");
     g.bench_function("len470_p30", |b| {
-        b.iter(|| predict(&config, &params, black_box(&u), &zero, &zero, 30, 3).unwrap())
+        b.iter(|| predict(config, params, black_box(u), &zero, &zero, 30, 3).unwrap())
     });
     g.finish();
 }

@@ -447,6 +447,7 @@ impl ConditionalWorkspace {
                     view(&self.w2, m, n).transpose(),
                     1.0,
                 );
+                // S̄-weighted W̄ term `2 W ⊙ (Sᵀσ̄²)`, added below with the base term.
                 gemm(
                     view_mut(&mut self.kbar, m, n),
                     Accum::Replace,
@@ -454,13 +455,6 @@ impl ConditionalWorkspace {
                     view(var_bar, dx, n),
                     1.0,
                 );
-                for ((wb, &s), &wv) in self.wbar[..m * n]
-                    .iter_mut()
-                    .zip(&self.kbar[..m * n])
-                    .zip(w)
-                {
-                    *wb += 2.0 * wv * s;
-                }
             }
             CovarianceStructure::Full => {
                 for dd in 0..dx {
@@ -504,6 +498,7 @@ impl ConditionalWorkspace {
             grads.variance += bb;
         }
         let kbar = &mut self.kbar[..m * n];
+        let diagonal = post.cov == CovarianceStructure::Diagonal;
         for (j, &bb) in self.base_bar[..n].iter().enumerate() {
             let cols = j * m..(j + 1) * m;
             let (wbc, wc, kc, kbc) = (
@@ -512,6 +507,21 @@ impl ConditionalWorkspace {
                 &k[cols.clone()],
                 &mut kbar[cols],
             );
+            if diagonal && !post.whitened {
+                // One pass: W̄ += 2 W ⊙ (Sᵀσ̄²) − β̄K, K̄ = −β̄W.
+                for (((wb, kb), &wv), &kv) in wbc.iter_mut().zip(kbc.iter_mut()).zip(wc).zip(kc) {
+                    *wb += 2.0 * wv * *kb;
+                    *wb -= bb * kv;
+                    *kb = -bb * wv;
+                }
+                continue;
+            }
+            if diagonal {
+                wbc.iter_mut()
+                    .zip(kbc.iter())
+                    .zip(wc)
+                    .for_each(|((wb, &s), &wv)| *wb += 2.0 * wv * s);
+            }
             if post.whitened {
                 let s = -2.0 * bb;
                 wbc.iter_mut().zip(wc).for_each(|(wb, &wv)| *wb += s * wv);
@@ -538,8 +548,7 @@ impl ConditionalWorkspace {
             view(k, m, n).transpose(),
             1.0,
         );
-        grads.variance += dot(kbar, k) / post.variance;
-        kbar.iter_mut().zip(&*t.kd).for_each(|(kb, &kd)| *kb *= kd);
+        grads.variance += dot_then_scale(kbar, k, t.kd) / post.variance;
         kernel::cross_cov_backward(
             kbar,
             &post.zt,
@@ -554,6 +563,30 @@ impl ConditionalWorkspace {
             &mut self.rowsum,
         );
     }
+}
+
+/// `Σ aᵢbᵢ` (the order of [`dot`]), then `aᵢ ← aᵢ cᵢ`, in one pass.
+#[inline]
+fn dot_then_scale(a: &mut [f64], b: &[f64], c: &[f64]) -> f64 {
+    let mut acc = [0.0; 8];
+    let n8 = a.len() / 8 * 8;
+    let (ah, at) = a.split_at_mut(n8);
+    for ((x, y), z) in ah
+        .chunks_exact_mut(8)
+        .zip(b.chunks_exact(8))
+        .zip(c.chunks_exact(8))
+    {
+        for l in 0..8 {
+            acc[l] = x[l].mul_add(y[l], acc[l]);
+            x[l] *= z[l];
+        }
+    }
+    let mut s = ((acc[0] + acc[4]) + (acc[1] + acc[5])) + ((acc[2] + acc[6]) + (acc[3] + acc[7]));
+    for ((x, y), z) in at.iter_mut().zip(&b[n8..]).zip(&c[n8..]) {
+        s = x.mul_add(*y, s);
+        *x *= z;
+    }
+    s
 }
 
 /// Forward-only conditional for prediction (no derivatives, no tape). `W` and the means come
@@ -682,6 +715,137 @@ impl PredictiveWorkspace {
             self.var[j * dx..(j + 1) * dx]
                 .iter_mut()
                 .for_each(|v| *v += base);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::params::ParamInit;
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    /// The forward-only path against the module-doc formulas evaluated with naive loops:
+    /// `K` from [`KernelKind::shape`], `G` from a dense Gauss–Jordan inverse of
+    /// `K_mm + jitter·I` (unwhitened) or of its Cholesky factor (whitened).
+    #[test]
+    fn predictive_forward_matches_naive_formulas() {
+        let (m, dx, du, group, n) = (9, 3, 2, 4, 8);
+        let d = dx + du;
+        for whitened in [false, true] {
+            for cov in [CovarianceStructure::Diagonal, CovarianceStructure::Full] {
+                let mut rng = ChaCha8Rng::seed_from_u64(5);
+                let mut config = ModelConfig::new(dx, 1, du, m);
+                config.covariance = cov;
+                config.kmm_jitter = 1e-6;
+                if whitened {
+                    config.parametrization = Parametrization::Whitened;
+                }
+                let mut p = Params::init(&config, &ParamInit::default(), 3);
+                p.q_mean
+                    .iter_mut()
+                    .for_each(|v| *v = rng.random_range(-1.0..1.0));
+                p.q_cov
+                    .iter_mut()
+                    .for_each(|v| *v = rng.random_range(0.05..0.3));
+                if cov == CovarianceStructure::Full {
+                    // Lower-triangular factors L_d.
+                    for (idx, v) in p.q_cov.iter_mut().enumerate() {
+                        if idx % m < (idx / m) % m {
+                            *v = 0.0;
+                        }
+                    }
+                }
+                let post = Posterior::new(&config, &p).unwrap();
+                let mut ws = PredictiveWorkspace::new(&post, n, group);
+                for c in 0..n {
+                    for j in 0..d {
+                        let shared = j >= dx && c % group != 0;
+                        ws.input[c * d + j] = if shared {
+                            ws.input[(c - c % group) * d + j]
+                        } else {
+                            rng.random_range(-1.5..1.5)
+                        };
+                    }
+                }
+                ws.forward(&post, n);
+                let kf = |a: &[f64], b: &[f64]| {
+                    let tau: f64 = (0..d)
+                        .map(|j| ((a[j] - b[j]) / p.lengthscales[j]).powi(2))
+                        .sum();
+                    p.kernel_variance * config.kernel.shape(tau, 0.0).0
+                };
+                let z = &p.inducing_inputs;
+                // Dense A = K_mm + jitter·I (or its factor L), inverted by Gauss–Jordan.
+                let mut a = vec![vec![0.0; m]; m];
+                for i in 0..m {
+                    for j in 0..m {
+                        a[i][j] = kf(&z[i * d..], &z[j * d..]);
+                    }
+                    a[i][i] += config.kmm_jitter;
+                }
+                if whitened {
+                    let l = &post.l;
+                    a = (0..m)
+                        .map(|i| (0..m).map(|j| l[j * m + i]).collect())
+                        .collect();
+                }
+                let mut g = vec![vec![0.0; m]; m];
+                for (i, row) in g.iter_mut().enumerate() {
+                    row[i] = 1.0;
+                }
+                for col in 0..m {
+                    let piv = a[col][col];
+                    for j in 0..m {
+                        a[col][j] /= piv;
+                        g[col][j] /= piv;
+                    }
+                    for r in 0..m {
+                        if r != col {
+                            let f = a[r][col];
+                            for j in 0..m {
+                                a[r][j] -= f * a[col][j];
+                                g[r][j] -= f * g[col][j];
+                            }
+                        }
+                    }
+                }
+                for c in 0..n {
+                    let x = &ws.input[c * d..(c + 1) * d];
+                    let k: Vec<f64> = (0..m).map(|i| kf(&z[i * d..], x)).collect();
+                    let w: Vec<f64> = (0..m)
+                        .map(|i| (0..m).map(|j| g[i][j] * k[j]).sum())
+                        .collect();
+                    let h = if whitened { &w } else { &k };
+                    let base = p.kernel_variance - (0..m).map(|i| h[i] * w[i]).sum::<f64>();
+                    for dd in 0..dx {
+                        let mean: f64 = (0..m).map(|i| p.q_mean[i * dx + dd] * w[i]).sum();
+                        let quad: f64 = match cov {
+                            CovarianceStructure::Diagonal => {
+                                (0..m).map(|i| p.q_cov[i * dx + dd] * w[i] * w[i]).sum()
+                            }
+                            CovarianceStructure::Full => {
+                                let ld = &p.q_cov[dd * m * m..];
+                                (0..m)
+                                    .map(|j| {
+                                        (j..m).map(|i| ld[j * m + i] * w[i]).sum::<f64>().powi(2)
+                                    })
+                                    .sum()
+                            }
+                        };
+                        let label = format!("whitened={whitened} {cov:?} point {c} dim {dd}");
+                        let got_mean = ws.mean(&post, c)[dd];
+                        assert!((got_mean - mean).abs() < 1e-9, "{label}: {got_mean} {mean}");
+                        let got_var = ws.var[c * dx + dd];
+                        assert!(
+                            (got_var - (base + quad)).abs() < 1e-9,
+                            "{label}: {got_var} {}",
+                            base + quad
+                        );
+                    }
+                }
+            }
         }
     }
 }

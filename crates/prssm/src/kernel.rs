@@ -164,14 +164,10 @@ pub(crate) fn cross_cov_grouped(
         .zip(xs.chunks(d * group))
     {
         sq_dist(zt, m_n, shared_from, &xg[shared_from..d], None, tau_shared);
-        for ((kc, kdc), x) in kg
-            .chunks_exact_mut(m_n)
-            .zip(kdg.chunks_exact_mut(m_n))
-            .zip(xg.chunks_exact(d))
-        {
+        for (kc, x) in kg.chunks_exact_mut(m_n).zip(xg.chunks_exact(d)) {
             sq_dist(zt, m_n, 0, &x[..shared_from], Some(tau_shared), kc);
-            apply_shape(kind, variance, matern_tau_jitter, kc, kdc);
         }
+        apply_shape(kind, variance, matern_tau_jitter, kg, kdg);
     }
 }
 
@@ -194,8 +190,9 @@ pub(crate) fn cross_cov_grouped_values(
         sq_dist(zt, m_n, shared_from, &xg[shared_from..d], None, tau_shared);
         for (kc, x) in kg.chunks_exact_mut(m_n).zip(xg.chunks_exact(d)) {
             sq_dist(zt, m_n, 0, &x[..shared_from], Some(tau_shared), kc);
-            apply_shape_values(kind, variance, matern_tau_jitter, kc);
         }
+        // Over the whole group: one vector loop without per-column scalar tails.
+        apply_shape_values(kind, variance, matern_tau_jitter, kg);
     }
 }
 

@@ -100,10 +100,10 @@ impl StepPredictor {
         self.ws.forward(&self.post, self.particles);
         for c in 0..self.particles {
             let mean = self.ws.mean(&self.post, c);
-            for dd in 0..dx {
+            for (dd, (&mu, &vx)) in mean.iter().zip(&self.process_noise_var).enumerate() {
                 let i = c * dx + dd;
-                let sd = (self.ws.var[i] + self.process_noise_var[dd] + self.jitter).sqrt();
-                x[i] += mean[dd] + sd * eps[i];
+                let sd = (self.ws.var[i] + vx + self.jitter).sqrt();
+                x[i] += mu + sd * eps[i];
             }
         }
     }

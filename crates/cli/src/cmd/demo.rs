@@ -29,6 +29,15 @@ pub struct DemoArgs {
     /// Override the number of training epochs.
     #[arg(long)]
     epochs: Option<u64>,
+    /// Override the latent state dimension D_x.
+    #[arg(long)]
+    dx: Option<usize>,
+    /// Override the number of inducing points M.
+    #[arg(long)]
+    inducing: Option<usize>,
+    /// Override the number of training particles.
+    #[arg(long)]
+    particles: Option<usize>,
 }
 
 /// Progress bars: one per stage, lines printed above.
@@ -141,6 +150,15 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
     }
     if let Some(e) = args.epochs {
         cfg.training.epochs = Some(e);
+    }
+    if let Some(d) = args.dx {
+        cfg.training.dx = Some(d);
+    }
+    if let Some(m) = args.inducing {
+        cfg.training.inducing = Some(m);
+    }
+    if let Some(p) = args.particles {
+        cfg.training.particles = Some(p);
     }
     let stop = stop_flag()?;
     let bars = Bars::new();

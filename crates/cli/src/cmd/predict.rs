@@ -51,15 +51,19 @@ pub fn run(args: PredictArgs) -> anyhow::Result<()> {
             table.columns.len()
         );
     }
-    if let Ok(r) = training_record(&model)
-        && r.initial_state.spec != InitialStateSpec::Zeros
-    {
-        eprintln!(
-            "warning: {} was trained with the initial-state rule {:?}, which needs the first \
-             outputs; --inputs predicts from x_0 = 0 (predict a dataset to apply the rule)",
-            args.model.display(),
-            r.initial_state.spec
-        );
+    if let Ok(r) = training_record(&model) {
+        let rule = match r.initial_state.spec {
+            InitialStateSpec::Zeros => None,
+            InitialStateSpec::Outputs => Some("outputs"),
+            _ => Some("recognition"),
+        };
+        if let Some(rule) = rule {
+            eprintln!(
+                "warning: {} was trained with the '{rule}' initial-state rule, which needs the \
+                 first outputs; --inputs predicts from x_0 = 0 (predict a dataset to apply it)",
+                args.model.display()
+            );
+        }
     }
     let t_n = table.n_rows();
     let inputs: Vec<f64> = (0..t_n)
