@@ -228,6 +228,31 @@ fn check_model_shape(model: &PrssmModel) -> Result<()> {
     Ok(())
 }
 
+/// The model as it applies to `ds`'s physical units: unchanged when it carries normalization
+/// statistics; otherwise (a model trained in standardized units, e.g. the published one) a copy
+/// that standardizes with `ds`'s training statistics, as the published post-processing did.
+///
+/// # Errors
+/// [`PipelineError::Dataset`] when the model has no statistics and `ds` has no outputs to
+/// compute them from.
+pub fn in_dataset_units<'m>(
+    model: &'m PrssmModel,
+    ds: &Dataset,
+) -> Result<std::borrow::Cow<'m, PrssmModel>> {
+    if model.normalization.is_some() {
+        return Ok(std::borrow::Cow::Borrowed(model));
+    }
+    let s = ds.standardization()?;
+    let mut m = model.clone();
+    m.normalization = Some(flapssm_prssm::Normalization {
+        input_mean: s.mean_u.to_vec(),
+        input_std: s.std_u.to_vec(),
+        output_mean: s.mean_y.to_vec(),
+        output_std: s.std_y.to_vec(),
+    });
+    Ok(std::borrow::Cow::Owned(m))
+}
+
 /// Predicts every trajectory of `ds` with the PR-SSM (in parallel with feature `parallel`;
 /// results do not depend on threading). `progress.advance(1)` per trajectory.
 ///
@@ -242,6 +267,7 @@ pub fn predict_prssm(
     progress: &dyn Progress,
 ) -> Result<Vec<PrssmPrediction>> {
     check_model_shape(model)?;
+    let model = &*in_dataset_units(model, ds)?;
     let one = |(i, t): (usize, &Trajectory)| -> Result<PrssmPrediction> {
         let p = predict_raw(
             model,
@@ -1772,6 +1798,47 @@ mod tests {
             assert!(dir.join(f).exists(), "{f}");
         }
         std::fs::remove_dir_all(&dir).ok();
+    }
+
+    #[test]
+    /// Regression: a model without normalization statistics (the published one works in
+    /// standardized units) used to receive raw inputs. It must predict exactly as the same
+    /// model carrying the dataset's training statistics.
+    fn a_model_without_statistics_uses_the_dataset_training_statistics() {
+        let ds = tiny_dataset();
+        let cfg = flapssm_prssm::ModelConfig::new(6, 5, 7, 4);
+        let params = flapssm_prssm::Params::init(&cfg, &Default::default(), 3);
+        let bare = PrssmModel {
+            config: cfg,
+            params,
+            normalization: None,
+            training: serde_json::Value::Null,
+        };
+        let s = ds.standardization().unwrap();
+        let mut with_stats = bare.clone();
+        with_stats.normalization = Some(flapssm_prssm::Normalization {
+            input_mean: s.mean_u.to_vec(),
+            input_std: s.std_u.to_vec(),
+            output_mean: s.mean_y.to_vec(),
+            output_std: s.std_y.to_vec(),
+        });
+        let a = predict_prssm(&bare, &ds, 3, 5, &NoProgress).unwrap();
+        let b = predict_prssm(&with_stats, &ds, 3, 5, &NoProgress).unwrap();
+        assert_eq!(a.len(), b.len());
+        for (x, y) in a.iter().zip(&b) {
+            assert_eq!(x.mean, y.mean);
+            assert_eq!(x.var, y.var);
+        }
+        // Raw inputs fed as if standardized would differ.
+        let mut raw = bare.clone();
+        raw.normalization = Some(flapssm_prssm::Normalization {
+            input_mean: vec![0.0; 7],
+            input_std: vec![1.0; 7],
+            output_mean: vec![0.0; 5],
+            output_std: vec![1.0; 5],
+        });
+        let c = predict_prssm(&raw, &ds, 3, 5, &NoProgress).unwrap();
+        assert_ne!(a[0].mean, c[0].mean);
     }
 
     #[test]

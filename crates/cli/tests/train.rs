@@ -146,6 +146,31 @@ fn resuming_with_another_configuration_is_refused_naming_the_field() {
     assert_fails(&o, &["lr", "0.01", s(&data)], &out);
 }
 
+/// Regression: resuming used to compare only the optimizer settings, so a checkpoint was
+/// silently continued with another particle count or on other data.
+#[test]
+fn resuming_with_another_model_setting_or_dataset_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let data = simulated(dir.path(), 6, 1);
+    let first = dir.path().join("m.json");
+    ok(&train_args(&data, &first, "5"));
+    let ckpt = dir.path().join("m.ckpt.json");
+    let out = dir.path().join("n.json");
+
+    let mut args = train_args(&data, &out, "5");
+    let p = args.iter().position(|a| *a == "--particles").unwrap();
+    args[p + 1] = "9";
+    args.extend(["--resume", "--checkpoint", s(&ckpt)]);
+    assert_fails(&flapssm(&args), &["particles", "4", "9"], &out);
+
+    let other_dir = dir.path().join("other");
+    std::fs::create_dir(&other_dir).unwrap();
+    let other = simulated(&other_dir, 6, 2);
+    let mut args = train_args(&other, &out, "5");
+    args.extend(["--resume", "--checkpoint", s(&ckpt)]);
+    assert_fails(&flapssm(&args), &["run_context.data"], &out);
+}
+
 #[test]
 fn a_divergent_learning_rate_is_reported_and_the_step_undone() {
     let dir = tempfile::tempdir().unwrap();

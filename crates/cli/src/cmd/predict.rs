@@ -6,9 +6,9 @@ use std::path::PathBuf;
 use anyhow::{Context, bail};
 use clap::Args;
 use flapssm_data::table::Table;
+use flapssm_prssm::PrssmModel;
 use flapssm_prssm::train::InitialStateSpec;
 use flapssm_prssm::train::fit::training_record;
-use flapssm_prssm::{Normalization, PrssmModel};
 
 /// Open-loop prediction with a PR-SSM model.
 #[derive(Args)]
@@ -94,7 +94,7 @@ fn run_dataset(args: PredictArgs) -> anyhow::Result<()> {
     let Some(ds_path) = args.dataset.as_ref() else {
         bail!("give a DATASET or --inputs");
     };
-    let mut model = PrssmModel::load(&args.model)
+    let model = PrssmModel::load(&args.model)
         .with_context(|| format!("loading model {}", args.model.display()))?;
     let ds = flapssm_data::Dataset::load(ds_path)
         .with_context(|| format!("loading dataset {}", ds_path.display()))?;
@@ -110,27 +110,23 @@ fn run_dataset(args: PredictArgs) -> anyhow::Result<()> {
         );
     }
     if model.normalization.is_none() {
-        let s = ds.standardization().with_context(|| {
-            format!(
-                "{} has no normalization statistics (standardized units) and {} has none to \
-                 offer",
-                args.model.display(),
-                ds_path.display()
-            )
-        })?;
         eprintln!(
             "note: {} has no normalization statistics; standardizing with the training \
              statistics of {}",
             args.model.display(),
             ds_path.display()
         );
-        model.normalization = Some(Normalization {
-            input_mean: s.mean_u.to_vec(),
-            input_std: s.std_u.to_vec(),
-            output_mean: s.mean_y.to_vec(),
-            output_std: s.std_y.to_vec(),
-        });
     }
+    let model = flapssm_analysis::pipeline::in_dataset_units(&model, &ds)
+        .with_context(|| {
+            format!(
+                "{} has no normalization statistics (standardized units) and {} has none to \
+                 offer",
+                args.model.display(),
+                ds_path.display()
+            )
+        })?
+        .into_owned();
     let (n, t_n) = (ds.len(), ds.n_samples());
     let bar = super::progress_bar(n as u64, "trajectories")?;
     let preds = ds

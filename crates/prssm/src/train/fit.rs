@@ -401,7 +401,18 @@ pub fn fit(
         Some(r) => r,
         None => &elbo,
     };
-    let outcome = train(objective, &lens, &init, &spec.train, hooks, resume)?;
+    // Everything besides the optimizer settings that defines the run, so that a checkpoint is
+    // only resumed with the same model, ELBO options and data.
+    let mut train_config = spec.train.clone();
+    let mut spec_rest = serde_json::to_value(spec).unwrap_or_default();
+    if let Some(obj) = spec_rest.as_object_mut() {
+        obj.remove("train");
+    }
+    train_config.run_context = serde_json::json!({
+        "fit": spec_rest,
+        "data": { "train": data_fingerprint(train_raw), "validation": data_fingerprint(val_raw) },
+    });
+    let outcome = train(objective, &lens, &init, &train_config, hooks, resume)?;
     let model_of = |flat: &[f64], which: &str| -> Result<PrssmModel, FitError> {
         Ok(PrssmModel {
             config: cfg.clone(),
@@ -458,4 +469,23 @@ pub fn predict_raw(
         }
     }
     Ok(pred)
+}
+
+/// A fingerprint of raw sequences: count, total length and an FNV-1a hash of every value's bits.
+fn data_fingerprint(sequences: &[Sequence]) -> serde_json::Value {
+    let mut hash: u64 = 0xcbf2_9ce4_8422_2325;
+    let mut n_values = 0usize;
+    for s in sequences {
+        for x in s.inputs.iter().chain(&s.outputs) {
+            for byte in x.to_bits().to_le_bytes() {
+                hash = (hash ^ u64::from(byte)).wrapping_mul(0x0000_0100_0000_01b3);
+            }
+            n_values += 1;
+        }
+    }
+    serde_json::json!({
+        "sequences": sequences.len(),
+        "values": n_values,
+        "fnv1a64": format!("{hash:016x}"),
+    })
 }

@@ -89,6 +89,10 @@ pub struct TrainConfig {
     pub checkpoint_every: u64,
     /// Divergence handling.
     pub divergence: DivergenceGuard,
+    /// What else defines the run (e.g. the model specification and a fingerprint of the
+    /// training data); compared like every other field when resuming. `null` if unused.
+    #[serde(default)]
+    pub run_context: serde_json::Value,
 }
 
 impl Default for TrainConfig {
@@ -105,6 +109,7 @@ impl Default for TrainConfig {
             eval_every: 1,
             checkpoint_every: 0,
             divergence: DivergenceGuard::default(),
+            run_context: serde_json::Value::Null,
         }
     }
 }
@@ -343,11 +348,45 @@ impl TrainConfig {
 /// First differing top-level field of two configurations.
 fn config_difference(a: &TrainConfig, b: &TrainConfig) -> Option<(String, String)> {
     let (va, vb) = (serde_json::to_value(a).ok()?, serde_json::to_value(b).ok()?);
-    let (oa, ob) = (va.as_object()?, vb.as_object()?);
-    oa.iter().find_map(|(k, x)| {
-        let y = ob.get(k)?;
-        (x != y).then(|| (k.clone(), format!("checkpoint {x}, now {y}")))
-    })
+    json_difference("", &va, &vb)
+}
+
+/// The first leaf where two JSON values differ, as (dotted path, "checkpoint X, now Y").
+fn json_difference(
+    path: &str,
+    a: &serde_json::Value,
+    b: &serde_json::Value,
+) -> Option<(String, String)> {
+    use serde_json::Value;
+    let join = |k: &str| {
+        if path.is_empty() {
+            k.to_string()
+        } else {
+            format!("{path}.{k}")
+        }
+    };
+    match (a, b) {
+        (Value::Object(oa), Value::Object(ob)) => {
+            let keys: std::collections::BTreeSet<&String> = oa.keys().chain(ob.keys()).collect();
+            keys.into_iter().find_map(|k| {
+                let null = Value::Null;
+                json_difference(
+                    &join(k),
+                    oa.get(k).unwrap_or(&null),
+                    ob.get(k).unwrap_or(&null),
+                )
+            })
+        }
+        (Value::Array(xa), Value::Array(xb)) if xa.len() == xb.len() => xa
+            .iter()
+            .zip(xb)
+            .enumerate()
+            .find_map(|(i, (x, y))| json_difference(&join(&i.to_string()), x, y)),
+        _ => (a != b).then(|| {
+            let field = if path.is_empty() { "config" } else { path };
+            (field.to_string(), format!("checkpoint {a}, now {b}"))
+        }),
+    }
 }
 
 fn all_finite(v: &[f64]) -> bool {
