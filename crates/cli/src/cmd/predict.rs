@@ -109,14 +109,7 @@ fn run_dataset(args: PredictArgs) -> anyhow::Result<()> {
             args.model.display()
         );
     }
-    if model.normalization.is_none() {
-        eprintln!(
-            "note: {} has no normalization statistics; standardizing with the training \
-             statistics of {}",
-            args.model.display(),
-            ds_path.display()
-        );
-    }
+    let bare = model.normalization.is_none();
     let model = flapssm_analysis::pipeline::in_dataset_units(&model, &ds)
         .with_context(|| {
             format!(
@@ -127,6 +120,14 @@ fn run_dataset(args: PredictArgs) -> anyhow::Result<()> {
             )
         })?
         .into_owned();
+    if bare {
+        eprintln!(
+            "note: {} has no normalization statistics; standardizing with the training \
+             statistics of {}",
+            args.model.display(),
+            ds_path.display()
+        );
+    }
     let (n, t_n) = (ds.len(), ds.n_samples());
     let bar = super::progress_bar(n as u64, "trajectories")?;
     let preds = ds
