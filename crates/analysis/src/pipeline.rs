@@ -1509,6 +1509,8 @@ pub struct TrainingOptions {
     pub particles: Option<usize>,
     /// Epochs.
     pub epochs: Option<u64>,
+    /// Optimizer steps (instead of epochs; wins over `epochs` when both are given).
+    pub iterations: Option<u64>,
     /// Windows per minibatch.
     pub batch: Option<usize>,
     /// Adam learning rate.
@@ -1534,6 +1536,7 @@ impl Default for TrainingOptions {
             inducing: None,
             particles: None,
             epochs: None,
+            iterations: None,
             batch: None,
             lr: None,
             schedule: None,
@@ -1561,6 +1564,9 @@ impl TrainingOptions {
         }
         if let Some(v) = self.epochs {
             spec.train.budget = Budget::Epochs(v);
+        }
+        if let Some(v) = self.iterations {
+            spec.train.budget = Budget::Iterations(v);
         }
         if let Some(v) = self.batch {
             spec.train.batch_size = v;

@@ -135,7 +135,7 @@ fn run_dataset(args: PredictArgs) -> anyhow::Result<()> {
         .par_iter()
         .enumerate()
         .map(|(i, traj)| {
-            let seq = super::train::trajectory_sequence(traj);
+            let seq = flapssm_analysis::pipeline::trajectory_sequence(traj);
             let p = predict_raw(
                 &model,
                 &seq,

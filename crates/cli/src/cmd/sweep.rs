@@ -102,6 +102,7 @@ fn run_one(a: RunArgs) -> anyhow::Result<()> {
         inducing: a.inducing,
         particles: a.particles,
         epochs: a.epochs,
+        iterations: None,
         batch: a.batch,
         lr: a.lr,
         schedule: None,

@@ -6,9 +6,10 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 use anyhow::{Context, bail};
 use clap::Args;
-use flapssm_data::{Dataset, Trajectory};
+use flapssm_analysis::pipeline::{TrainingOptions, trajectory_sequence};
+use flapssm_data::Dataset;
 use flapssm_prssm::Sequence;
-use flapssm_prssm::train::fit::{FitSpec, Preset, fit};
+use flapssm_prssm::train::fit::{Preset, fit};
 use flapssm_prssm::train::{Budget, Checkpoint, LrSchedule, TrainEvent, TrainHooks};
 use indicatif::{ProgressBar, ProgressStyle};
 
@@ -91,19 +92,6 @@ fn parse_schedule(s: &str) -> anyhow::Result<LrSchedule> {
     })
 }
 
-/// One trajectory as a raw PR-SSM sequence (7 inputs, 5 outputs; `outputs` empty when the
-/// dataset has none).
-pub fn trajectory_sequence(t: &Trajectory) -> Sequence {
-    Sequence {
-        inputs: t.inputs.iter().flatten().copied().collect(),
-        outputs: t
-            .outputs
-            .as_ref()
-            .map(|y| y.iter().flatten().copied().collect())
-            .unwrap_or_default(),
-    }
-}
-
 /// `<dir>/<stem><suffix>` next to `path`.
 fn sibling(path: &Path, suffix: &str) -> PathBuf {
     let stem = path
@@ -123,45 +111,31 @@ pub fn run(args: TrainArgs) -> anyhow::Result<()> {
             args.dataset.display()
         );
     }
-    let all: Vec<Sequence> = ds.train().iter().map(trajectory_sequence).collect();
     if !(0.0..1.0).contains(&args.val_fraction) {
         bail!("--val-fraction {} must be in [0, 1)", args.val_fraction);
     }
-    let n_val =
-        ((all.len() as f64 * args.val_fraction).round() as usize).min(all.len().saturating_sub(1));
-    let (train_seqs, val_seqs) = all.split_at(all.len() - n_val);
-    if train_seqs.is_empty() {
-        bail!("{}: no training trajectories", args.dataset.display());
-    }
-
-    let mut spec = FitSpec::preset(args.preset, 7, 5);
-    if let Some(v) = args.dx {
-        spec.model.n_state = v;
-    }
-    if let Some(v) = args.inducing {
-        spec.model.n_inducing = v;
-    }
-    if let Some(v) = args.particles {
-        spec.particles = v;
-        spec.eval_particles = v;
-    }
-    if let Some(v) = args.epochs {
-        spec.train.budget = Budget::Epochs(v);
-    }
-    if let Some(v) = args.iterations {
-        spec.train.budget = Budget::Iterations(v);
-    }
-    if let Some(v) = args.batch {
-        spec.train.batch_size = v;
-    }
-    if let Some(v) = args.lr {
-        spec.train.lr = v;
-    }
-    if let Some(s) = &args.schedule {
-        spec.train.schedule = parse_schedule(s)?;
-    }
-    spec.train.seed = args.seed;
-    spec.train.checkpoint_every = args.checkpoint_every;
+    let schedule = args.schedule.as_deref().map(parse_schedule).transpose()?;
+    let options = TrainingOptions {
+        preset: args.preset,
+        dx: args.dx,
+        inducing: args.inducing,
+        particles: args.particles,
+        epochs: args.epochs,
+        iterations: args.iterations,
+        batch: args.batch,
+        lr: args.lr,
+        schedule,
+        eval_every: None,
+        seed: args.seed,
+        val_fraction: args.val_fraction,
+        checkpoint_every: args.checkpoint_every,
+    };
+    let (fit_part, val_part) = options
+        .split(ds.train())
+        .with_context(|| format!("{}: no training trajectories", args.dataset.display()))?;
+    let train_seqs: Vec<Sequence> = fit_part.iter().map(trajectory_sequence).collect();
+    let val_seqs: Vec<Sequence> = val_part.iter().map(trajectory_sequence).collect();
+    let spec = options.spec();
 
     let ck_path = args
         .checkpoint
@@ -246,8 +220,8 @@ pub fn run(args: TrainArgs) -> anyhow::Result<()> {
     );
     let out = fit(
         &spec,
-        train_seqs,
-        val_seqs,
+        &train_seqs,
+        &val_seqs,
         TrainHooks {
             evaluate: None,
             progress: Some(&mut progress),
