@@ -50,16 +50,6 @@ pub fn training_curves(
             .margin(14)
             .x_label_area_size(44)
             .y_label_area_size(80);
-        let series = |i: usize, c: &TrainingCurve<'_>| {
-            let col = PALETTE[i % PALETTE.len()];
-            (
-                LineSeries::new(
-                    c.epochs.iter().copied().zip(c.values.iter().copied()),
-                    col.stroke_width(2),
-                ),
-                col,
-            )
-        };
         if log_y {
             let lo = curves
                 .iter()
@@ -69,43 +59,46 @@ pub fn training_curves(
                 .fold(f64::INFINITY, f64::min);
             let hi = y1.max(lo * 10.0);
             let mut ch = b.build_cartesian_2d(x0..x1, (lo * 0.8..hi * 1.2).log_scale())?;
-            ch.configure_mesh()
-                .x_desc("epoch")
-                .y_desc(y_label)
-                .label_style(font(15.0))
-                .light_line_style(RGBColor(235, 235, 235))
-                .draw()?;
-            for (i, c) in curves.iter().enumerate() {
-                let (s, col) = series(i, c);
-                ch.draw_series(s)?.label(c.label).legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 24, y)], col.stroke_width(3))
-                });
-            }
-            ch.configure_series_labels()
-                .label_font(font(15.0))
-                .background_style(WHITE.mix(0.85))
-                .border_style(RGBColor(180, 180, 180))
-                .draw()?;
+            draw_curves(&mut ch, y_label, curves)?;
         } else {
             let mut ch = b.build_cartesian_2d(x0..x1, y0..y1)?;
-            ch.configure_mesh()
-                .x_desc("epoch")
-                .y_desc(y_label)
-                .label_style(font(15.0))
-                .light_line_style(RGBColor(235, 235, 235))
-                .draw()?;
-            for (i, c) in curves.iter().enumerate() {
-                let (s, col) = series(i, c);
-                ch.draw_series(s)?.label(c.label).legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 24, y)], col.stroke_width(3))
-                });
-            }
-            ch.configure_series_labels()
-                .label_font(font(15.0))
-                .background_style(WHITE.mix(0.85))
-                .border_style(RGBColor(180, 180, 180))
-                .draw()?;
+            draw_curves(&mut ch, y_label, curves)?;
         }
         Ok::<(), Box<dyn std::error::Error>>(())
     })
+}
+
+/// Mesh, one line per curve and the legend, on a linear or logarithmic y axis.
+fn draw_curves<'a, DB, Y>(
+    ch: &mut ChartContext<'a, DB, Cartesian2d<plotters::coord::types::RangedCoordf64, Y>>,
+    y_label: &str,
+    curves: &[TrainingCurve<'_>],
+) -> std::result::Result<(), Box<dyn std::error::Error>>
+where
+    DB: DrawingBackend + 'a,
+    DB::ErrorType: 'static,
+    Y: Ranged<ValueType = f64> + plotters::coord::ranged1d::ValueFormatter<f64>,
+{
+    ch.configure_mesh()
+        .x_desc("epoch")
+        .y_desc(y_label)
+        .label_style(font(15.0))
+        .light_line_style(RGBColor(235, 235, 235))
+        .draw()?;
+    for (i, c) in curves.iter().enumerate() {
+        let col = PALETTE[i % PALETTE.len()];
+        let line = LineSeries::new(
+            c.epochs.iter().copied().zip(c.values.iter().copied()),
+            col.stroke_width(2),
+        );
+        ch.draw_series(line)?
+            .label(c.label)
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], col.stroke_width(3)));
+    }
+    ch.configure_series_labels()
+        .label_font(font(15.0))
+        .background_style(WHITE.mix(0.85))
+        .border_style(RGBColor(180, 180, 180))
+        .draw()?;
+    Ok(())
 }
