@@ -191,7 +191,12 @@ fn theodorsen_harmonic_plunge() {
 
 /// Eldredge canonical pitch-up (45°, K = 0.4, LE pivot, LESP_crit = 0.11, smoothing σ = 0.8).
 fn eldredge(t: f64) -> (f64, f64) {
-    let (amp, k, sigma) = (PI / 4.0, 0.4, 0.8);
+    eldredge_k(t, 0.4)
+}
+
+/// Eldredge pitch-up to 45° at reduced pitch rate K = α̇c/(2U).
+fn eldredge_k(t: f64, k: f64) -> (f64, f64) {
+    let (amp, sigma) = (PI / 4.0, 0.8);
     let a = PI * PI * k / (2.0 * amp * (1.0 - sigma));
     let (t1, t2) = (1.0, 1.0 + amp / (2.0 * k));
     let lc = |x: f64| x.abs() + (1.0 + (-2.0 * x.abs()).exp()).ln() - 2f64.ln(); // ln cosh x
@@ -239,18 +244,21 @@ struct EldredgeRun {
     cl: Vec<f64>,
     /// C_L = −(dI/dt)_Z/(½ρU²c) from the vortex impulse (backward difference, at t − Δt/2).
     cl_impulse: Vec<f64>,
+    /// Σ Γ_LEV shed up to t* = 1 + (π/4)/(2K) for K = 0.4 (U c).
+    lev_at_ramp_end: f64,
 }
 
 /// Runs the Eldredge case to t* = 5 (Δt* = 0.015, UNSflow's step), checking at each step before
 /// the first LEV that |A0| ≤ 0.11 and at the first LEV step that the unshed |A0| > 0.11 and the
 /// shed one is 0.11.
 fn eldredge_run() -> EldredgeRun {
+    eldredge_run_with(eldredge, 0.015)
+}
+
+/// [`eldredge_run`] for the pitch schedule `alpha` and time step `dt` (convective units).
+fn eldredge_run_with(alpha: fn(f64) -> (f64, f64), dt: f64) -> EldredgeRun {
     let (c, u, rho) = (1.0, 1.0, 1.0);
-    let m = Motion {
-        u,
-        alpha: eldredge,
-        h: zero,
-    };
+    let m = Motion { u, alpha, h: zero };
     let p = LdvmParams {
         chord_m: c,
         u_ref_m_s: u,
@@ -260,19 +268,22 @@ fn eldredge_run() -> EldredgeRun {
         lev_decay_chords: None,
         tev_decay_chords: None,
         far_field_chords: None,
-        max_vortices: 400,
+        max_vortices: (12.0 / dt) as usize,
         ..LdvmParams::default()
     };
-    let dt = 0.015;
     let mut ldvm = Ldvm::new(p).unwrap();
     let mut onset = None;
     let (mut t_out, mut cl, mut cl_imp) = (vec![], vec![], vec![]);
     let mut i_prev = [0.0; 2];
+    let mut lev_at_ramp_end = 0.0;
     for k in 0..((5.0 / dt) as usize) {
         let t = k as f64 * dt;
         let plate = plate_at(&m, t);
         let l = ldvm.step(&plate, dt).unwrap();
         let d = *ldvm.diagnostics();
+        if t <= ELDREDGE_T2 {
+            lev_at_ramp_end += d.lev_m2_s;
+        }
         if onset.is_none() {
             if d.lev_m2_s != 0.0 {
                 assert!(
@@ -306,6 +317,7 @@ fn eldredge_run() -> EldredgeRun {
         t: t_out,
         cl,
         cl_impulse: cl_imp,
+        lev_at_ramp_end,
     }
 }
 
@@ -370,6 +382,57 @@ fn eldredge_pitch_up_lift_during_ramp() {
         (2.0..=4.0).contains(&mean_after),
         "C_L after the ramp: {mean_after}"
     );
+}
+
+/// Smoothed (±0.075 t*) peak C_L after the LEV onset: (value, t*).
+fn eldredge_peak(r: &EldredgeRun, dt: f64) -> (f64, f64) {
+    let cl = smooth(&r.cl, (0.075 / dt).round() as usize);
+    r.t.iter()
+        .zip(&cl)
+        .filter(|(t, _)| **t > r.onset.0 + 0.1)
+        .fold(
+            (f64::NEG_INFINITY, 0.0),
+            |a, (&t, &c)| if c > a.0 { (c, t) } else { a },
+        )
+}
+
+/// The LEV-shedding solution converges with the time step: halving Δt* (0.015 → 0.0075) moves
+/// the smoothed peak C_L by < 2 % and its time by < 0.05 t*, and the LEV circulation shed by the
+/// end of the ramp by < 5 %. (Δt* = 0.03 → 0.015 moves the peak by ≈ 4 %.)
+#[test]
+fn eldredge_lev_solution_converges_with_time_step() {
+    let (a, b) = (
+        eldredge_run_with(eldredge, 0.015),
+        eldredge_run_with(eldredge, 0.0075),
+    );
+    let (pa, pb) = (eldredge_peak(&a, 0.015), eldredge_peak(&b, 0.0075));
+    let (ga, gb) = (a.lev_at_ramp_end, b.lev_at_ramp_end);
+    println!(
+        "Δt* 0.015: peak C_L {:.3} at {:.3}, ΣΓ_LEV(t2) {ga:.3}; Δt* 0.0075: {:.3} at {:.3}, {gb:.3}",
+        pa.0, pa.1, pb.0, pb.1
+    );
+    assert!((pa.0 - pb.0).abs() < 0.02 * pb.0, "peaks {pa:?} vs {pb:?}");
+    assert!((pa.1 - pb.1).abs() < 0.05, "peak times {pa:?} vs {pb:?}");
+    assert!((ga - gb).abs() < 0.05 * gb.abs(), "ΣΓ_LEV {ga} vs {gb}");
+}
+
+/// Eldredge's canonical K = 0.2 case (45°, LE pivot, LESP_crit 0.11): the smoothed peak C_L
+/// lies in the published LDVM/CFD band 3.5–5 (Ramesh et al. 2014; Eldredge et al. 2009) and
+/// occurs during the ramp (which ends at t* = 1 + (π/4)/0.4 ≈ 2.96).
+#[test]
+fn eldredge_k02_peak_lift_in_published_band() {
+    fn k02(t: f64) -> (f64, f64) {
+        eldredge_k(t, 0.2)
+    }
+    let r = eldredge_run_with(k02, 0.015);
+    let (pk, tp) = eldredge_peak(&r, 0.015);
+    let t2 = 1.0 + PI / 4.0 / 0.4;
+    println!(
+        "K = 0.2: LEV onset t* = {:.3}, smoothed peak C_L {pk:.3} at t* = {tp:.3}",
+        r.onset.0
+    );
+    assert!((3.5..=5.0).contains(&pk), "peak C_L {pk}");
+    assert!(tp > r.onset.0 && tp < t2, "peak at t* = {tp}");
 }
 
 /// 2-D hovering: surge ±A along X with the LE leading, 45° geometric AoA at mid-stroke, a 2ω
@@ -544,4 +607,290 @@ fn kelvin_total_circulation_is_zero_without_decay() {
         "LEV shedding and amalgamation must both be exercised"
     );
     assert!(worst < 1e-12 * g_max.max(1e-300) * 100.0);
+}
+
+/// Measurement (ignored, open gap): 2-D hover, |C_N| (smoothed over 1/300 cycle) at 600, 1200
+/// and 2400 steps per cycle.
+#[test]
+#[ignore = "measurement of an open gap (docs/vortex-method.md)"]
+fn study_hover_spikes() {
+    let h = Hover {
+        c: 0.06,
+        a: 0.24,
+        w: 1.25,
+        mirror: false,
+    };
+    let p = LdvmParams::default();
+    for spc in [600usize, 1200, 2400] {
+        let (_, a) = h.run(p, 3.0, spc);
+        let q = 0.5 * p.rho_kg_m3 * h.u_ref().powi(2) * h.c;
+        let cn: Vec<f64> = a.iter().map(|l| l.normal_n_m / q).collect();
+        let cn = smooth(&cn, spc / 300);
+        let mut s: Vec<f64> = cn.iter().map(|x| x.abs()).collect();
+        s.sort_by(|a, b| a.partial_cmp(b).unwrap());
+        println!(
+            "spc {spc}: hover smoothed |C_N| max {:.1}, p99 {:.1}, p90 {:.1}, median {:.1}; cycle means {:.2} {:.2} {:.2}",
+            s[s.len() - 1],
+            s[s.len() * 99 / 100],
+            s[s.len() * 9 / 10],
+            s[s.len() / 2],
+            cn[..spc].iter().sum::<f64>() / spc as f64,
+            cn[spc..2 * spc].iter().sum::<f64>() / spc as f64,
+            cn[2 * spc..].iter().sum::<f64>() / spc as f64
+        );
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Wing level: the strip LDVM through the blade-element integrator.
+
+use flapssm_wing::aero::blade_element::{BladeElement, BladeGeometry};
+use flapssm_wing::aero::quasi_steady::{QuasiSteadyParams, QuasiSteadySection};
+use flapssm_wing::aero::{SectionGeometry, SectionKinematics, SectionModel};
+use flapssm_wing::kinematics::{EulerState, WingKinematics, rotation_global_from_wing};
+use flapssm_wing::vortex::{StripLdvm, StripLdvmFactory, StripLdvmParams};
+
+/// The dataset plate: 0.18 × 0.06 m, r0 = 0.055 m, pitch axis 15 %, oil, sensor at the root.
+fn blade() -> BladeGeometry {
+    BladeGeometry {
+        span_m: 0.18,
+        chord_m: 0.06,
+        root_offset_m: 0.055,
+        pitch_axis_frac: 0.15,
+        density_kg_m3: 800.0,
+        sensor_radius_m: 0.055,
+    }
+}
+
+/// Robofly-like hovering (as in tests/physics.rs): φ = 80° sin(2πft), ψ = 0, α = ∓45° at
+/// mid-stroke with a tanh-shaped rotation of sharpness `k` = 3, scaled in time by `f`.
+fn hover_state(t: f64, f: f64) -> EulerState {
+    let (amp, a_pitch, k) = (80f64.to_radians(), PI / 4.0, 3.0);
+    let w = 2.0 * PI * f;
+    let x = w * t;
+    let u = k * x.cos();
+    let (u1, u2) = (-k * x.sin() * w, -k * x.cos() * w * w);
+    let g = u.tanh();
+    let g1 = (1.0 - g * g) * u1;
+    let g2 = (1.0 - g * g) * u2 - 2.0 * g * (1.0 - g * g) * u1 * u1;
+    let s = -a_pitch / k.tanh();
+    EulerState {
+        angles_rad: [amp * x.sin(), 0.0, s * g],
+        rates_rad_s: [amp * w * x.cos(), 0.0, s * g1],
+        accels_rad_s2: [-amp * w * w * x.sin(), 0.0, s * g2],
+    }
+}
+
+/// Runs the L2 blade element (`n_strips` strips) over `states` sampled every `dt`.
+fn run_blade(states: &[EulerState], dt: f64, n_strips: usize) -> Vec<[f64; 5]> {
+    let factory = StripLdvmFactory::default();
+    let mut be = BladeElement::new(blade(), n_strips, &factory).unwrap();
+    states
+        .iter()
+        .enumerate()
+        .map(|(k, s)| {
+            be.step(
+                &WingKinematics::from_euler(s),
+                if k == 0 { 0.0 } else { dt },
+            )
+        })
+        .collect()
+}
+
+const F_HOVER: f64 = 0.3;
+const PER_CYCLE: usize = 500;
+
+fn hover_states(f: f64, cycles: usize) -> (Vec<EulerState>, f64) {
+    let dt = 1.0 / f / PER_CYCLE as f64;
+    let n = cycles * PER_CYCLE;
+    ((0..n).map(|i| hover_state(i as f64 * dt, f)).collect(), dt)
+}
+
+/// (φ, ψ, α) → (−φ, ψ, −α) mirrors the wing frame in x_w: F_x, M_y, M_z change sign, F_y and
+/// M_x do not (< 1 % of each channel's peak).
+#[test]
+fn wing_l2_mirror_symmetry() {
+    let (states, dt) = hover_states(F_HOVER, 2);
+    let mirrored: Vec<EulerState> = states
+        .iter()
+        .map(|s| {
+            let m = |v: [f64; 3]| [-v[0], v[1], -v[2]];
+            EulerState {
+                angles_rad: m(s.angles_rad),
+                rates_rad_s: m(s.rates_rad_s),
+                accels_rad_s2: m(s.accels_rad_s2),
+            }
+        })
+        .collect();
+    let a = run_blade(&states, dt, 2);
+    let b = run_blade(&mirrored, dt, 2);
+    let sign = [-1.0, 1.0, 1.0, -1.0, -1.0];
+    for c in 0..5 {
+        let scale = max_abs(a.iter().map(|y| y[c]));
+        let d = max_abs(a.iter().zip(&b).map(|(x, y)| y[c] - sign[c] * x[c]));
+        println!(
+            "L2 mirror channel {c}: max {scale:.3e}, rel. diff {:.2e}",
+            d / scale
+        );
+        assert!(
+            scale > 0.0 && d <= 0.01 * scale,
+            "channel {c}: {d} vs {scale}"
+        );
+    }
+}
+
+/// A wing at rest (any attitude) carries no aerodynamic load.
+#[test]
+fn wing_l2_zero_motion_gives_zero_load() {
+    let st = EulerState {
+        angles_rad: [0.3, -0.1, 0.7],
+        rates_rad_s: [0.0; 3],
+        accels_rad_s2: [0.0; 3],
+    };
+    let y = run_blade(&[st; 300], 0.004, 2);
+    assert!(
+        y.iter().all(|v| v.iter().all(|x| *x == 0.0)),
+        "{:?}",
+        y[299]
+    );
+}
+
+/// Doubling the flapping frequency (same samples per cycle) multiplies every load by 4: the
+/// coefficients agree to < 1 % of each channel's peak. Fails today: the vortex–plate
+/// encounters after reversal make the hover chaotic (docs/vortex-method.md, Known gaps).
+#[test]
+#[ignore = "open gap: L2 hover not yet stable (docs/vortex-method.md)"]
+fn wing_l2_time_scaling() {
+    let (slow, dt) = hover_states(F_HOVER, 2);
+    let (fast, dt2) = hover_states(2.0 * F_HOVER, 2);
+    let a = run_blade(&slow, dt, 2);
+    let b = run_blade(&fast, dt2, 2);
+    for c in 0..5 {
+        let scale = max_abs(a.iter().map(|y| y[c]));
+        let d = max_abs(a.iter().zip(&b).map(|(x, y)| y[c] / 4.0 - x[c]));
+        println!("L2 time scaling channel {c}: rel. diff {:.2e}", d / scale);
+        assert!(d <= 0.01 * scale, "channel {c}: {d} vs {scale}");
+    }
+}
+
+/// Robofly-like hover at L2 (2 Gauss strips, last of 4 cycles): cycle-mean C_L (Robofly
+/// convention, Sane & Dickinson 2001) in [1.0, 1.8]; C_F (½ρSU_ref²) in [−4, 7] and C_M
+/// (½ρc̄SU_ref²) in [−11, 13] at every sample, as in the dataset's plots (physics notes §4.4.9).
+/// Fails today (docs/vortex-method.md, Known gaps).
+#[test]
+#[ignore = "open gap: L2 hover not yet stable (docs/vortex-method.md)"]
+fn wing_l2_hovering_sanity() {
+    let cycles = 4;
+    let (states, dt) = hover_states(F_HOVER, cycles);
+    let y = run_blade(&states, dt, 2);
+    let n = states.len();
+    let amp = 80f64.to_radians();
+    let u_ref = 0.235 * 4.0 * amp * F_HOVER;
+    let q_s = 0.5 * 800.0 * 0.0108 * u_ref * u_ref;
+    let i2 = (0.235f64.powi(3) - 0.055f64.powi(3)) / 3.0;
+    let (mut lift, mut phi_dot2) = (0.0, 0.0);
+    let (mut cf_rng, mut cm_rng) = ((f64::MAX, f64::MIN), (f64::MAX, f64::MIN));
+    for i in n - PER_CYCLE..n {
+        let r = rotation_global_from_wing(&states[i].angles_rad);
+        lift += r[1][0] * y[i][0] + r[1][1] * y[i][1];
+        phi_dot2 += states[i].rates_rad_s[0].powi(2);
+        for v in [y[i][0] / q_s, y[i][1] / q_s] {
+            cf_rng = (cf_rng.0.min(v), cf_rng.1.max(v));
+        }
+        for m in &y[i][2..5] {
+            let v = m / (1e3 * q_s * 0.06);
+            cm_rng = (cm_rng.0.min(v), cm_rng.1.max(v));
+        }
+    }
+    let q_robofly = 0.5 * 800.0 * 0.06 * i2 * phi_dot2 / PER_CYCLE as f64;
+    let cl = lift / PER_CYCLE as f64 / q_robofly;
+    println!("L2 hover: mean C_L {cl:.3}, C_F range {cf_rng:.2?}, C_M range {cm_rng:.2?}");
+    assert!((1.0..=1.8).contains(&cl), "cycle-mean C_L = {cl}");
+    assert!(cf_rng.0 >= -4.0 && cf_rng.1 <= 7.0, "C_F range {cf_rng:?}");
+    assert!(
+        cm_rng.0 >= -11.0 && cm_rng.1 <= 13.0,
+        "C_M range {cm_rng:?}"
+    );
+}
+
+/// Section kinematics of the strip at radius `r` (as the blade-element integrator forms them).
+fn section_kin(s: &EulerState, r: f64) -> SectionKinematics {
+    let k = WingKinematics::from_euler(s);
+    let (wz, wzd) = (k.omega_rad_s[2], k.omega_dot_rad_s2[2]);
+    SectionKinematics {
+        normal_velocity_m_s: r * k.v_x,
+        chord_velocity_m_s: r * k.v_y,
+        normal_velocity_rate_m_s2: r * (k.a[0] + wz * k.v_y),
+        chord_velocity_rate_m_s2: r * (k.a[1] - wz * k.v_x),
+        rotation_rate_rad_s: wz,
+        rotation_acc_rad_s2: wzd,
+    }
+}
+
+/// Wake capture emerges: at r_cp of the hovering wing, the mean normal force over the first
+/// 15 % of each half-stroke after a reversal (cycles 3–4), with the wake kept, minus the same
+/// with all free vortices deleted at the reversal, compared with the quasi-steady model.
+/// Returns (full − QS, deleted − QS, QS) means (N/m, sign of the translational force).
+fn wake_capture_measure() -> (f64, f64, f64) {
+    let (states, dt) = hover_states(F_HOVER, 4);
+    let geom = SectionGeometry {
+        chord_m: 0.06,
+        pitch_axis_frac: 0.15,
+        radius_m: 0.178,
+        density_kg_m3: 800.0,
+    };
+    let qs = QuasiSteadySection::new(geom, QuasiSteadyParams::default());
+    let mut full = StripLdvm::new(StripLdvmParams::default(), &geom);
+    let mut cut = StripLdvm::new(StripLdvmParams::default(), &geom);
+    let half = PER_CYCLE / 2;
+    // reversals at φ̇ = 0: t = (k + ½)·T/2 → sample index (2k + 1)·PER_CYCLE/4
+    let window = (0.15 * half as f64) as usize;
+    let (mut d_full, mut d_cut, mut q_sum, mut m) = (0.0, 0.0, 0.0, 0);
+    for (i, s) in states.iter().enumerate() {
+        let kin = section_kin(s, 0.178);
+        let dti = if i == 0 { 0.0 } else { dt };
+        let rel = (i + PER_CYCLE / 4) % half; // samples since the last reversal
+        if rel == 0 && i > 0 {
+            cut.clear_wake();
+        }
+        let lf = full.step(&kin, dti).normal_n_m;
+        let lc = cut.step(&kin, dti).normal_n_m;
+        let lq = qs.loads(&kin).normal_n_m;
+        if i >= 2 * PER_CYCLE && rel < window {
+            // sign of the translational force of this half-stroke
+            let sg = -kin.normal_velocity_m_s.signum();
+            d_full += sg * (lf - lq);
+            d_cut += sg * (lc - lq);
+            q_sum += sg * lq;
+            m += 1;
+        }
+    }
+    let m = m as f64;
+    (d_full / m, d_cut / m, q_sum / m)
+}
+
+/// Measurement (ignored, open gap): wake capture at r_cp, with and without the wake.
+#[test]
+#[ignore = "measurement of an open gap (docs/vortex-method.md)"]
+fn study_wake_capture() {
+    let (a, b, q) = wake_capture_measure();
+    println!("after reversal: (L2 − QS) {a:.4} N/m with wake, {b:.4} N/m wake deleted; QS {q:.4}");
+}
+
+/// Measurement (ignored, open gap): per-cycle peak |C_Fx| of the L2 Robofly hover.
+#[test]
+#[ignore = "measurement of an open gap (docs/vortex-method.md)"]
+fn study_wing_hover_trace() {
+    let (states, dt) = hover_states(F_HOVER, 4);
+    let y = run_blade(&states, dt, 2);
+    let u_ref = 0.235 * 4.0 * 80f64.to_radians() * F_HOVER;
+    let q_s = 0.5 * 800.0 * 0.0108 * u_ref * u_ref;
+    for cyc in 0..4 {
+        let m = max_abs(
+            y[cyc * PER_CYCLE + 5..(cyc + 1) * PER_CYCLE]
+                .iter()
+                .map(|v| v[0] / q_s),
+        );
+        println!("cycle {cyc}: max |C_Fx| {m:.2}");
+    }
 }

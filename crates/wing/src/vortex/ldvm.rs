@@ -188,6 +188,14 @@ impl Ldvm {
         self.diag = LdvmDiagnostics::default();
     }
 
+    /// Deletes every free vortex (wake and LEVs) but keeps the bound sheet and its history: the
+    /// next step sheds the circulation that Kelvin then requires, as if the fluid around the
+    /// plate had been replaced by fluid at rest. For wake-capture experiments.
+    pub fn clear_wake(&mut self) {
+        self.wake.clear();
+        self.last_lev_step = None;
+    }
+
     /// Sets U_ref (m/s, > 0 and finite; other values are ignored) for the LESP criterion and
     /// amalgamation from the next step on.
     pub fn set_reference_speed(&mut self, u_ref_m_s: f64) {

@@ -17,6 +17,17 @@
 //! knowledge of the trajectory and scales with the motion, so coefficients are invariant under
 //! time scaling.
 //!
+//! # Sub-steps
+//!
+//! The vortex convection (forward Euler) needs steps of at most Δs_max = `max_step_chords`·c of
+//! travel (UNSflow's Δt* = 0.015): with the 250 Hz samples of the rig (≈ 0.025 c per sample at
+//! U_ref) vortices shed at reversal and met again jump too far in one step, and the loads show
+//! isolated spikes of |C_N| up to 10³ (2-D hover test). Each sample interval is therefore split
+//! into n = ⌈U_max Δt/(Δs_max c)⌉ (at most `max_substeps`) equal sub-steps, U_max the largest of
+//! the pivot speed, U_ref and the edge speeds |ω|·max(x_p, c − x_p), with the section velocities
+//! and ω interpolated linearly across the interval. The loads are those of the last sub-step
+//! (the sample instant).
+//!
 //! # 3-D correction
 //!
 //! The normal force and the pitching moment are multiplied by `cn_3d_factor` (default 0.8 for the
@@ -36,6 +47,10 @@ pub struct StripLdvmParams {
     pub ldvm: LdvmParams,
     /// 3-D factor on the normal force and pitching moment (dimensionless, default 0.8).
     pub cn_3d_factor: f64,
+    /// Largest travel per vortex step, in chords (default 0.0125).
+    pub max_step_chords: f64,
+    /// Cap on the sub-steps per sample interval (default 8).
+    pub max_substeps: usize,
 }
 
 impl Default for StripLdvmParams {
@@ -43,6 +58,8 @@ impl Default for StripLdvmParams {
         Self {
             ldvm: LdvmParams::default(),
             cn_3d_factor: 0.8,
+            max_step_chords: 0.0125,
+            max_substeps: 8,
         }
     }
 }
@@ -65,6 +82,9 @@ impl SectionModelFactory for StripLdvmFactory {
 pub struct StripLdvm {
     ldvm: Option<Ldvm>,
     cn_3d_factor: f64,
+    max_step_m: f64,
+    max_substeps: usize,
+    prev_kin: SectionKinematics,
     plate: PlateState,
     started: bool,
     time_s: f64,
@@ -82,9 +102,15 @@ impl StripLdvm {
             rho_kg_m3: section.density_kg_m3,
             ..params.ldvm
         };
+        let valid = params.max_step_chords.is_finite()
+            && params.max_step_chords > 0.0
+            && params.max_substeps >= 1;
         Self {
-            ldvm: Ldvm::new(p).ok(),
+            ldvm: Ldvm::new(p).ok().filter(|_| valid),
             cn_3d_factor: params.cn_3d_factor,
+            max_step_m: params.max_step_chords * section.chord_m,
+            max_substeps: params.max_substeps,
+            prev_kin: SectionKinematics::default(),
             plate: PlateState::default(),
             started: false,
             time_s: 0.0,
@@ -96,6 +122,13 @@ impl StripLdvm {
     /// The 2-D solver (None when the settings were invalid).
     pub fn ldvm(&self) -> Option<&Ldvm> {
         self.ldvm.as_ref()
+    }
+
+    /// Deletes the free vortices of the 2-D solver (see [`Ldvm::clear_wake`]).
+    pub fn clear_wake(&mut self) {
+        if let Some(l) = self.ldvm.as_mut() {
+            l.clear_wake();
+        }
     }
 
     fn inertial_velocity(angle_rad: f64, kin: &SectionKinematics) -> [f64; 2] {
@@ -115,6 +148,7 @@ impl SectionModel for StripLdvm {
         self.time_s = 0.0;
         self.distance_m = 0.0;
         self.prev_speed_m_s = 0.0;
+        self.prev_kin = SectionKinematics::default();
     }
 
     fn step(&mut self, kin: &SectionKinematics, dt_s: f64) -> SectionLoads {
@@ -123,9 +157,54 @@ impl SectionModel for StripLdvm {
             chordwise_n_m: f64::NAN,
             moment_n: f64::NAN,
         };
-        let Some(ldvm) = self.ldvm.as_mut() else {
+        let Some(ldvm) = self.ldvm.as_ref() else {
             return nan;
         };
+        if !(self.started && dt_s.is_finite() && dt_s > 0.0) {
+            return self.substep(kin, dt_s).unwrap_or(nan);
+        }
+        let p = ldvm.params();
+        let (c, xp) = (p.chord_m, p.pivot_frac * p.chord_m);
+        let edge = xp.max(c - xp);
+        let u_max = [
+            kin.speed_m_s(),
+            self.prev_kin.speed_m_s(),
+            p.u_ref_m_s,
+            kin.rotation_rate_rad_s.abs() * edge,
+            self.prev_kin.rotation_rate_rad_s.abs() * edge,
+        ]
+        .into_iter()
+        .fold(0.0, f64::max);
+        let n = ((u_max * dt_s / self.max_step_m).ceil() as usize).clamp(1, self.max_substeps);
+        let k0 = self.prev_kin;
+        let h = dt_s / n as f64;
+        let mut out = nan;
+        for i in 1..=n {
+            let f = i as f64 / n as f64;
+            let lerp = |a: f64, b: f64| a + f * (b - a);
+            let ki = if i == n {
+                *kin
+            } else {
+                SectionKinematics {
+                    normal_velocity_m_s: lerp(k0.normal_velocity_m_s, kin.normal_velocity_m_s),
+                    chord_velocity_m_s: lerp(k0.chord_velocity_m_s, kin.chord_velocity_m_s),
+                    rotation_rate_rad_s: lerp(k0.rotation_rate_rad_s, kin.rotation_rate_rad_s),
+                    ..*kin
+                }
+            };
+            match self.substep(&ki, h) {
+                Some(l) => out = l,
+                None => return nan,
+            }
+        }
+        out
+    }
+}
+
+impl StripLdvm {
+    /// One LDVM step of `dt_s` to the kinematics `kin`; None on a solver error.
+    fn substep(&mut self, kin: &SectionKinematics, dt_s: f64) -> Option<SectionLoads> {
+        let ldvm = self.ldvm.as_mut()?;
         let speed = kin.speed_m_s();
         let omega = kin.rotation_rate_rad_s;
         // the first step starts impulsively; its dt only sets the first TEV position
@@ -149,6 +228,7 @@ impl SectionModel for StripLdvm {
         }
         self.plate.angle_rate_rad_s = omega;
         self.prev_speed_m_s = speed;
+        self.prev_kin = *kin;
         let u_ref = if self.time_s > 0.0 {
             self.distance_m / self.time_s
         } else {
@@ -156,13 +236,11 @@ impl SectionModel for StripLdvm {
         };
         ldvm.set_reference_speed(u_ref);
         self.started = true;
-        match ldvm.step(&self.plate, dt) {
-            Ok(l) => SectionLoads {
-                normal_n_m: self.cn_3d_factor * l.normal_n_m,
-                chordwise_n_m: -l.chord_n_m,
-                moment_n: self.cn_3d_factor * l.moment_pivot_n,
-            },
-            Err(_) => nan,
-        }
+        let l = ldvm.step(&self.plate, dt).ok()?;
+        Some(SectionLoads {
+            normal_n_m: self.cn_3d_factor * l.normal_n_m,
+            chordwise_n_m: -l.chord_n_m,
+            moment_n: self.cn_3d_factor * l.moment_pivot_n,
+        })
     }
 }

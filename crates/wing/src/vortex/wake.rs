@@ -245,7 +245,8 @@ impl Wake {
     /// `d0_m` = D0 in m, distances d measured to the plate segment `le`–`te`. Merges pairs below
     /// the threshold (only vortices farther than `near_m` from the plate), then more pairs
     /// (smallest measure first, any distance) while the count exceeds `target`. Never merges the
-    /// newest TEV/LEV. Conserves Σ Γ.
+    /// newest TEV/LEV, nor a pair whose merged position would be closer to the plate than both
+    /// (a pair on opposite sides of the plate). Conserves Σ Γ.
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn amalgamate(
         &mut self,
@@ -288,8 +289,15 @@ impl Wake {
                 let dij = (self.x[i] - self.x[j]).hypot(self.z[i] - self.z[j]);
                 let m =
                     (gi * gj).abs() / (gi + gj).abs() * dij / ((d0_m + di) * (d0_m + dj)).powf(1.5);
+                // never merge across the plate: the merged vortex must not lie closer to it
+                // than both constituents (it would sit on the plate)
                 if m < best.0 {
-                    best = (m, j as u32);
+                    let g = gi + gj;
+                    let xm = (gi * self.x[i] + gj * self.x[j]) / g;
+                    let zm = (gi * self.z[i] + gj * self.z[j]) / g;
+                    if dist(xm, zm) >= 0.999 * di.min(dj) {
+                        best = (m, j as u32);
+                    }
                 }
             }
             if best.0.is_finite() {
@@ -383,6 +391,22 @@ impl Wake {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Same-sign vortices on opposite sides of the plate are never merged (the merged vortex
+    /// would sit on the plate); on the same side they are.
+    #[test]
+    fn amalgamation_never_merges_across_the_plate() {
+        let (le, te) = ([0.0, 0.0], [1.0, 0.0]);
+        for (zb, expect) in [(-0.1, 3), (0.12, 2)] {
+            let mut wake = Wake::with_capacity(8);
+            wake.push(0.5, 0.1, 1.0, VortexKind::Lev);
+            wake.push(0.55, zb, 1.0, VortexKind::Lev);
+            wake.push(5.0, 5.0, -1.0, VortexKind::Lev); // newest: protected
+            wake.amalgamate(le, te, 1.0, 0.0, 1e9, 1);
+            assert_eq!(wake.len(), expect, "second vortex at z = {zb}");
+            assert!((wake.total_circulation() - 1.0).abs() < 1e-15);
+        }
+    }
 
     #[test]
     fn point_vortex_far_field_is_biot_savart() {
