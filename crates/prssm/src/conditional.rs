@@ -576,10 +576,16 @@ fn dot_then_scale(a: &mut [f64], b: &[f64], c: &[f64]) -> f64 {
         .zip(b.chunks_exact(8))
         .zip(c.chunks_exact(8))
     {
+        // Whole-array loads and stores, so that the loop vectorizes.
+        let xv: [f64; 8] = (&*x).try_into().expect("chunk of 8");
+        let yv: [f64; 8] = y.try_into().expect("chunk of 8");
+        let zv: [f64; 8] = z.try_into().expect("chunk of 8");
+        let mut out = [0.0; 8];
         for l in 0..8 {
-            acc[l] = x[l].mul_add(y[l], acc[l]);
-            x[l] *= z[l];
+            acc[l] = xv[l].mul_add(yv[l], acc[l]);
+            out[l] = xv[l] * zv[l];
         }
+        x.copy_from_slice(&out);
     }
     let mut s = ((acc[0] + acc[4]) + (acc[1] + acc[5])) + ((acc[2] + acc[6]) + (acc[3] + acc[7]));
     for ((x, y), z) in at.iter_mut().zip(&b[n8..]).zip(&c[n8..]) {

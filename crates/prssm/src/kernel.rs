@@ -293,7 +293,8 @@ fn apply_shape_values(kind: KernelKind, variance: f64, jitter: f64, k: &mut [f64
 /// through the products `C X̃ᵀ` and `Z̃ᵀ C` (two GEMMs). `zbar_t` is dimension-major
 /// (`zbar_t[j·M + m]`, without the factor `2/ℓ_j`: see [`finish_inducing_grad`]); `xbar`
 /// (`n_xbar_rows × N`) gets the full adjoint of rows `j < n_xbar_rows`; `len_acc[j]`
-/// accumulates `Σ c d²`. Scratch: `cx` (`M·D`), `zc` (`D·N`), `rowsum` (`M`). Allocates nothing.
+/// accumulates `Σ c d²`. Scratch: `cx` (`M·D`), `zc` (`D·N`; `n_xbar_rows·N` are used),
+/// `rowsum` (`M`). Allocates nothing.
 #[allow(clippy::too_many_arguments)]
 pub fn cross_cov_backward(
     c: &[f64],
@@ -319,17 +320,28 @@ pub fn cross_cov_backward(
         view(xs, d, n_pts).transpose(),
         1.0,
     );
+    // Only the rows of X̄ that are wanted: `Z̃[:, ..n_xbar_rows]ᵀ C`.
+    let nx = n_xbar_rows;
     gemm(
-        view_mut(zc, d, n_pts),
+        view_mut(zc, nx, n_pts),
         faer::Accum::Replace,
-        view(zt, m_n, d).transpose(),
+        view(zt, m_n, d).subcols(0, nx).transpose(),
         view(c, m_n, n_pts),
         1.0,
     );
+    // One pass over `C`: column sums `s_n = Σ_m c[m, n]` (X̄, ℓ̄) and row sums `Σ_n c[m, n]`.
     let rowsum = &mut rowsum[..m_n];
     rowsum.fill(0.0);
-    for col in c[..m_n * n_pts].chunks_exact(m_n) {
+    for (n, col) in c[..m_n * n_pts].chunks_exact(m_n).enumerate() {
+        let s = crate::linalg::sum(col);
         rowsum.iter_mut().zip(col).for_each(|(r, v)| *r += v);
+        for j in 0..d {
+            let x = xs[n * d + j];
+            len_acc[j] += x * x * s;
+            if j < nx {
+                xbar[n * nx + j] -= 2.0 * inv_len[j] * (zc[n * nx + j] - x * s);
+            }
+        }
     }
     for j in 0..d {
         let zj = &zt[j * m_n..(j + 1) * m_n];
@@ -345,16 +357,6 @@ pub fn cross_cov_backward(
             l += z * z * r - 2.0 * z * q;
         }
         len_acc[j] += l;
-    }
-    for n in 0..n_pts {
-        let s = crate::linalg::sum(&c[n * m_n..(n + 1) * m_n]);
-        for j in 0..d {
-            let x = xs[n * d + j];
-            len_acc[j] += x * x * s;
-            if j < n_xbar_rows {
-                xbar[n * n_xbar_rows + j] -= 2.0 * inv_len[j] * (zc[n * d + j] - x * s);
-            }
-        }
     }
 }
 

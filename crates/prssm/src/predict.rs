@@ -109,6 +109,8 @@ impl StepPredictor {
     }
 }
 
+/// Particle mean and variance (divided by `P`) of `x` (`P × D_x`) at step `t`, plus the
+/// noise variances. The sums over particles run in particle order for all dims at once.
 fn moments(
     x: &[f64],
     dx: usize,
@@ -119,18 +121,26 @@ fn moments(
     t: usize,
 ) {
     let p = (x.len() / dx) as f64;
+    let mean = &mut out.latent_mean[t * dx..(t + 1) * dx];
+    mean.fill(0.0);
+    for c in x.chunks_exact(dx) {
+        mean.iter_mut().zip(c).for_each(|(m, &v)| *m += v);
+    }
+    mean.iter_mut().for_each(|m| *m /= p);
+    let var = &mut out.latent_var[t * dx..(t + 1) * dx];
+    var.fill(0.0);
+    for c in x.chunks_exact(dx) {
+        var.iter_mut()
+            .zip(c)
+            .zip(mean.iter())
+            .for_each(|((s, &v), &m)| *s += (v - m) * (v - m));
+    }
     for dd in 0..dx {
-        let mean = x.chunks_exact(dx).map(|c| c[dd]).sum::<f64>() / p;
-        let var = x
-            .chunks_exact(dx)
-            .map(|c| (c[dd] - mean).powi(2))
-            .sum::<f64>()
-            / p;
-        out.latent_mean[t * dx + dd] = mean;
-        out.latent_var[t * dx + dd] = var + vx[dd];
+        let v = var[dd] / p;
+        var[dd] = v + vx[dd];
         if dd < dy {
-            out.output_mean[t * dy + dd] = mean;
-            out.output_var[t * dy + dd] = var + vy[dd];
+            out.output_mean[t * dy + dd] = mean[dd];
+            out.output_var[t * dy + dd] = v + vy[dd];
         }
     }
 }
