@@ -4,11 +4,12 @@
 //!
 //! `cargo run --release -p flapssm-analysis --example sysid_validate -- FILE IN OUT VARIANT [SEEDS]`
 //! with VARIANT a comma-separated list of `reference`, `linear-recognition`, `lr=X`,
-//! `cosine=FINAL_FACTOR`.
+//! `cosine=FINAL_FACTOR`, `restarts=R`, `select` (combine restarts by selection instead of
+//! the ensemble).
 
 use std::path::Path;
 
-use flapssm_analysis::sysid::{IoRecord, SysidSpec, run};
+use flapssm_analysis::sysid::{Combine, IoRecord, SysidSpec, run};
 use flapssm_prssm::train::{InitialStateSpec, LrSchedule, RecognitionConfig};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -27,6 +28,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     for token in a[4].split(',') {
         match token.split_once('=') {
             None if token == "reference" => {}
+            None if token == "select" => spec.combine = Combine::Select,
+            None if token == "snapshots" => spec.combine = Combine::Snapshots,
+            Some(("restarts", v)) => spec.restarts = v.parse()?,
             None if token == "linear-recognition" => {
                 spec.fit.initial_state = InitialStateSpec::Recognition(RecognitionConfig {
                     hidden: 0,
@@ -44,11 +48,21 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     let (report, _) = run(&train_part, &spec, true, |r| {
         eprintln!(
-            "seed {}: val RMSE best {:.4} last {:.4} ({:.0} s)",
+            "seed {}: val RMSE best {:.4} last {:.4} ({:.0} s); restarts (train, val, val last): {}",
             r.seed,
             r.test.rmse,
             r.last_test.map_or(f64::NAN, |l| l.rmse),
-            r.wall_s
+            r.wall_s,
+            r.restarts
+                .iter()
+                .map(|x| format!(
+                    "({:.4}, {:.4}, {:.4})",
+                    x.best_train_rmse.unwrap_or(f64::NAN),
+                    x.test.rmse,
+                    x.last_test.map_or(f64::NAN, |l| l.rmse)
+                ))
+                .collect::<Vec<_>>()
+                .join(" ")
         )
     })?;
     let last: Vec<f64> = report

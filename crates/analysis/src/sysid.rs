@@ -6,9 +6,11 @@
 //! 1. Split the `T` samples at `n_train = ⌊split · T⌋`: train `0..n_train`, test `n_train..T`.
 //! 2. Fit the `sysid` preset of [`FitSpec`] (z-scoring with training statistics, ddof 0;
 //!    windows of 50 at stride 1, batch 10, `D_x = 4`, `M = 20`, SE-ARD, 50 particles,
-//!    Adam lr 0.1, 3000 iterations, recognition of `x₀` from the first 16 steps) once per seed.
+//!    Adam lr 0.1, 3000 iterations, recognition of `x₀` from the first 16 steps) `R` times
+//!    per seed ([`SysidSpec::restarts`], in parallel; `R = 1` in the reference protocol).
 //! 3. Predict the whole test part open loop, the initial state recognized from its first 16
-//!    steps of `(u, y)`, and score every test step:
+//!    steps of `(u, y)`, combine the restarts ([`Combine`]; [`mixture`]) and score every
+//!    test step:
 //!
 //! ```text
 //! RMSE_raw = sqrt( 1/(T_test·D_y) Σ_t Σ_j (y_tj − m_tj)² )                     (raw units)
@@ -32,6 +34,16 @@ use serde::{Deserialize, Serialize};
 
 /// Seed stream of test-time particle draws.
 const PREDICT_STREAM: u64 = 40;
+
+/// Seed stream of the training seeds of restarts `r ≥ 1`.
+const RESTART_STREAM: u64 = 41;
+
+/// One fitted restart: its record and test-part predictions (raw units).
+struct Restart {
+    run: RestartRun,
+    best: Prediction,
+    last: Option<Prediction>,
+}
 
 /// Fewest training samples the protocol accepts.
 pub const MIN_TRAIN_SAMPLES: usize = 100;
@@ -187,6 +199,22 @@ impl IoRecord {
     }
 }
 
+/// How the restarts of one seed are turned into one prediction.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Combine {
+    /// Equal-weight mixture of the `R` restarts' predictive distributions, moment-matched:
+    /// `m = (1/R) Σ_r m_r`, `v = (1/R) Σ_r (v_r + m_r²) − m²`. Its RMSE is never above the
+    /// mean RMSE of the restarts (convexity of the squared error).
+    Ensemble,
+    /// The restart with the lowest open-loop RMSE on the training part (standardized units;
+    /// `x₀` recognized from its first steps, as at test time).
+    Select,
+    /// Like [`Combine::Ensemble`] over `2R` members: the selected (best) and the last
+    /// parameters of every restart (a snapshot ensemble).
+    Snapshots,
+}
+
 /// Settings of the protocol.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SysidSpec {
@@ -194,10 +222,25 @@ pub struct SysidSpec {
     pub split: f64,
     /// Seeds `0..seeds` (one fit each; the seed replaces `fit.train.seed`).
     pub seeds: u64,
-    /// Particles of the test-time prediction.
+    /// Independent fits per seed (≥ 1), run in parallel. Restart 0 uses the seed itself,
+    /// restart `r ≥ 1` the training seed `derive_seed(seed, 41, r)`.
+    #[serde(default = "one_restart")]
+    pub restarts: usize,
+    /// How the restarts are combined (irrelevant for one restart).
+    #[serde(default = "ensemble")]
+    pub combine: Combine,
+    /// Particles of the test-time prediction (per restart).
     pub predict_particles: usize,
     /// The fit (model sizes must match the record's `D_u`, `D_y`).
     pub fit: FitSpec,
+}
+
+fn one_restart() -> usize {
+    1
+}
+
+fn ensemble() -> Combine {
+    Combine::Ensemble
 }
 
 impl SysidSpec {
@@ -207,6 +250,8 @@ impl SysidSpec {
         Self {
             split: 0.5,
             seeds: 3,
+            restarts: 1,
+            combine: Combine::Ensemble,
             predict_particles: 50,
             fit: FitSpec::preset(Preset::Sysid, n_input, n_output),
         }
@@ -237,6 +282,9 @@ impl SysidSpec {
             Budget::Iterations(0) | Budget::Epochs(0)
         ) {
             return bad("iterations", "0".into(), "must be ≥ 1");
+        }
+        if self.restarts == 0 {
+            return bad("restarts", "0".into(), "must be ≥ 1");
         }
         if self.predict_particles == 0 {
             return bad("predict_particles", "0".into(), "must be ≥ 1");
@@ -281,25 +329,79 @@ pub fn score(y: &[f64], mean: &[f64], var: &[f64], std: &[f64]) -> Scores {
     }
 }
 
+/// One restart (independent fit) of a seed.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RestartRun {
+    /// Training seed of this fit.
+    pub train_seed: u64,
+    /// Epoch of the fit's selected parameters (lowest open-loop RMSE on the training part).
+    pub best_epoch: Option<u64>,
+    /// That open-loop RMSE on the training part (standardized units).
+    pub best_train_rmse: Option<f64>,
+    /// Test scores of this restart alone (diagnostics; never used for a choice).
+    pub test: Scores,
+    /// Test scores of its last parameters, when predicted (diagnostics).
+    pub last_test: Option<Scores>,
+    /// Steps rejected by the divergence guard.
+    pub rejected_steps: u64,
+}
+
 /// One seed's result.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SeedRun {
     /// Seed.
     pub seed: u64,
-    /// Test scores.
+    /// Test scores of the combined prediction ([`Combine`]).
     pub test: Scores,
     /// Per-output test RMSE, raw units (`D_y`).
     pub rmse_per_output: Vec<f64>,
-    /// Wall time of fit + prediction, seconds.
+    /// Wall time of all fits + predictions of this seed, seconds.
     pub wall_s: f64,
-    /// Steps rejected by the divergence guard.
+    /// Steps rejected by the divergence guard, over all restarts.
     pub rejected_steps: u64,
-    /// Epoch of the selected model (lowest open-loop RMSE on the training part).
-    pub best_epoch: Option<u64>,
-    /// That open-loop RMSE on the training part (standardized units).
-    pub best_train_rmse: Option<f64>,
-    /// Test scores of the last (not the selected best) parameters, when asked for.
+    /// Index of the restart chosen by [`Combine::Select`] (`None` for an ensemble of several).
+    pub selected_restart: Option<usize>,
+    /// Per restart.
+    pub restarts: Vec<RestartRun>,
+    /// Test scores of the last (not the selected best) parameters, combined the same way,
+    /// when asked for.
     pub last_test: Option<Scores>,
+}
+
+/// Equal-weight moment-matched mixture of predictions of the same outputs:
+/// `m = (1/R) Σ m_r`, `v = (1/R) Σ (v_r + m_r²) − m²` (outputs only; the latent moments are
+/// left empty because latent coordinates of different fits are not comparable). `None` when
+/// `preds` is empty or the output lengths differ.
+pub fn mixture(preds: &[Prediction]) -> Option<Prediction> {
+    let first = preds.first()?;
+    let n = first.output_mean.len();
+    if preds
+        .iter()
+        .any(|p| p.output_mean.len() != n || p.output_var.len() != n)
+    {
+        return None;
+    }
+    let r = preds.len() as f64;
+    let mut mean = vec![0.0; n];
+    let mut second = vec![0.0; n];
+    for p in preds {
+        for i in 0..n {
+            let m = p.output_mean[i];
+            mean[i] += m / r;
+            second[i] += (p.output_var[i] + m * m) / r;
+        }
+    }
+    let var = second
+        .iter()
+        .zip(&mean)
+        .map(|(s, m)| (s - m * m).max(0.0))
+        .collect();
+    Some(Prediction {
+        output_mean: mean,
+        output_var: var,
+        latent_mean: Vec::new(),
+        latent_var: Vec::new(),
+    })
 }
 
 /// Mean and standard deviation (ddof 0) over seeds.
@@ -431,51 +533,112 @@ pub fn run(
     .rmse;
     let mut runs = Vec::new();
     let mut first: Option<Prediction> = None;
+    let score_of = |p: &Prediction| {
+        score(
+            &test.outputs,
+            &p.output_mean,
+            &p.output_var,
+            &norm.output_std,
+        )
+    };
     for seed in 0..spec.seeds {
         let t0 = Instant::now();
-        let mut fs = spec.fit.clone();
-        fs.train.seed = seed;
         let err = |source| SysidError::Fit { seed, source };
-        let out = fit(
-            &fs,
-            std::slice::from_ref(&train),
-            &[],
-            TrainHooks::default(),
-            None,
-        )
-        .map_err(err)?;
-        let pred = predict_raw(
-            &out.best,
-            &test,
-            spec.predict_particles,
-            derive_seed(seed, PREDICT_STREAM, 0),
-        )
-        .map_err(err)?;
-        let wall_s = t0.elapsed().as_secs_f64();
-        let last_scores = match diagnose_last {
-            true => {
-                let p = predict_raw(
+        let one = |r: usize| -> Result<Restart, FitError> {
+            let mut fs = spec.fit.clone();
+            fs.train.seed = match r {
+                0 => seed,
+                _ => derive_seed(seed, RESTART_STREAM, r as u64),
+            };
+            let out = fit(
+                &fs,
+                std::slice::from_ref(&train),
+                &[],
+                TrainHooks::default(),
+                None,
+            )?;
+            let predict_seed = derive_seed(seed, PREDICT_STREAM, r as u64);
+            let best = predict_raw(&out.best, &test, spec.predict_particles, predict_seed)?;
+            let last = match diagnose_last || spec.combine == Combine::Snapshots {
+                true => Some(predict_raw(
                     &out.last,
                     &test,
                     spec.predict_particles,
-                    derive_seed(seed, PREDICT_STREAM, 0),
-                )
-                .map_err(err)?;
-                Some(score(
-                    &test.outputs,
-                    &p.output_mean,
-                    &p.output_var,
-                    &norm.output_std,
-                ))
-            }
-            false => None,
+                    predict_seed,
+                )?),
+                false => None,
+            };
+            let state = &out.outcome.state;
+            Ok(Restart {
+                run: RestartRun {
+                    train_seed: fs.train.seed,
+                    best_epoch: state.best.as_ref().map(|b| b.epoch),
+                    best_train_rmse: state.best.as_ref().map(|b| b.score),
+                    test: score_of(&best),
+                    last_test: last.as_ref().map(&score_of),
+                    rejected_steps: state.rejected,
+                },
+                best,
+                last,
+            })
         };
-        let test_scores = score(
-            &test.outputs,
-            &pred.output_mean,
-            &pred.output_var,
-            &norm.output_std,
-        );
+        let fits: Vec<Result<Restart, FitError>> = {
+            #[cfg(feature = "parallel")]
+            {
+                use rayon::prelude::*;
+                (0..spec.restarts).into_par_iter().map(one).collect()
+            }
+            #[cfg(not(feature = "parallel"))]
+            {
+                (0..spec.restarts).map(one).collect()
+            }
+        };
+        let fits = fits
+            .into_iter()
+            .collect::<Result<Vec<_>, _>>()
+            .map_err(err)?;
+        let selected = match (spec.combine, fits.len()) {
+            (Combine::Snapshots, _) => None,
+            (_, 1) => Some(0),
+            (Combine::Ensemble, _) => None,
+            (Combine::Select, _) => fits
+                .iter()
+                .enumerate()
+                .min_by(|a, b| {
+                    let key = |f: &Restart| f.run.best_train_rmse.unwrap_or(f64::INFINITY);
+                    key(a.1).total_cmp(&key(b.1))
+                })
+                .map(|(i, _)| i),
+        };
+        let combined = |pick: &dyn Fn(&Restart) -> Option<&Prediction>| -> Option<Prediction> {
+            match selected {
+                Some(i) => pick(&fits[i]).cloned(),
+                None => {
+                    let preds: Option<Vec<Prediction>> =
+                        fits.iter().map(|f| pick(f).cloned()).collect();
+                    mixture(&preds?)
+                }
+            }
+        };
+        let pred = match spec.combine {
+            Combine::Snapshots => {
+                let preds: Vec<Prediction> = fits
+                    .iter()
+                    .flat_map(|f| std::iter::once(&f.best).chain(&f.last))
+                    .cloned()
+                    .collect();
+                mixture(&preds)
+            }
+            _ => combined(&|f| Some(&f.best)),
+        }
+        .ok_or_else(|| SysidError::Setting {
+            field: "restarts",
+            value: spec.restarts.to_string(),
+            why: "the restarts' predictions have different lengths".into(),
+        })?;
+        let last_scores = combined(&|f| f.last.as_ref()).map(|p| score_of(&p));
+        let wall_s = t0.elapsed().as_secs_f64();
+        let test_scores = score_of(&pred);
         let rmse_per_output = (0..dy)
             .map(|j| {
                 let (mut s2, mut k) = (0.0, 0.0);
@@ -497,9 +660,9 @@ pub fn run(
             test: test_scores,
             rmse_per_output,
             wall_s,
-            rejected_steps: out.outcome.state.rejected,
-            best_epoch: out.outcome.state.best.as_ref().map(|b| b.epoch),
-            best_train_rmse: out.outcome.state.best.as_ref().map(|b| b.score),
+            rejected_steps: fits.iter().map(|f| f.run.rejected_steps).sum(),
+            selected_restart: selected,
+            restarts: fits.into_iter().map(|f| f.run).collect(),
             last_test: last_scores,
         };
         progress(&r);
@@ -552,6 +715,58 @@ mod tests {
             0.5 * (ln2pi + 4f64.ln()) + 0.5,
         ];
         assert!((s.nll - nll.iter().sum::<f64>() / 4.0).abs() < 1e-14);
+    }
+
+    fn prediction(mean: &[f64], var: &[f64]) -> Prediction {
+        Prediction {
+            output_mean: mean.to_vec(),
+            output_var: var.to_vec(),
+            latent_mean: vec![0.0; 4],
+            latent_var: vec![1.0; 4],
+        }
+    }
+
+    #[test]
+    fn mixture_matches_moments_of_the_equal_weight_mixture() {
+        // Components N(0, 1) and N(2, 3): mean 1, variance (1 + 3)/2 + (0² + 2²)/2 − 1² = 3.
+        let a = prediction(&[0.0, -1.0], &[1.0, 0.5]);
+        let b = prediction(&[2.0, -1.0], &[3.0, 0.25]);
+        let m = mixture(&[a.clone(), b]).unwrap();
+        assert_eq!(m.output_mean, [1.0, -1.0]);
+        assert!((m.output_var[0] - 3.0).abs() < 1e-14);
+        assert!((m.output_var[1] - 0.375).abs() < 1e-14);
+        assert!(m.latent_mean.is_empty() && m.latent_var.is_empty());
+        // One component is itself.
+        let one = mixture(std::slice::from_ref(&a)).unwrap();
+        assert_eq!(one.output_mean, a.output_mean);
+        assert!(
+            one.output_var
+                .iter()
+                .zip(&a.output_var)
+                .all(|(x, y)| (x - y).abs() < 1e-15)
+        );
+        assert!(mixture(&[]).is_none());
+        assert!(mixture(&[a, prediction(&[0.0], &[1.0])]).is_none());
+    }
+
+    #[test]
+    fn mixture_rmse_never_exceeds_mean_member_rmse() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+        let std = [1.5];
+        for _ in 0..100 {
+            let y: Vec<f64> = (0..20).map(|_| rng.random_range(-2.0..2.0)).collect();
+            let members: Vec<Prediction> = (0..rng.random_range(2..5))
+                .map(|_| {
+                    let m: Vec<f64> = (0..20).map(|_| rng.random_range(-3.0..3.0)).collect();
+                    prediction(&m, &[0.5; 20])
+                })
+                .collect();
+            let mix = mixture(&members).unwrap();
+            let rmse = |p: &Prediction| score(&y, &p.output_mean, &p.output_var, &std).rmse;
+            let mean_member = members.iter().map(rmse).sum::<f64>() / members.len() as f64;
+            assert!(rmse(&mix) <= mean_member + 1e-12);
+        }
     }
 
     #[test]
@@ -617,5 +832,13 @@ mod tests {
         .unwrap_err()
         .to_string();
         assert!(e.contains("seeds"), "{e}");
+        let e = SysidSpec {
+            restarts: 0,
+            ..SysidSpec::reference(1, 1)
+        }
+        .check(1, 1)
+        .unwrap_err()
+        .to_string();
+        assert!(e.contains("restarts"), "{e}");
     }
 }

@@ -213,3 +213,85 @@ fn short_run_on_actuator_beats_the_mean_predictor() {
     let svg = std::fs::read_to_string(&fig).unwrap();
     assert!(svg.starts_with("<svg") && svg.contains("test sample"));
 }
+
+/// Short actuator run with the given extra arguments; the parsed JSON report.
+fn short_actuator_run(extra: &[&str]) -> serde_json::Value {
+    let mat = sysid_file("actuator.mat");
+    let mut args = vec![
+        "sysid",
+        mat.to_str().unwrap(),
+        "--input",
+        "u",
+        "--output",
+        "p",
+        "--seeds",
+        "1",
+        "--iterations",
+        "100",
+        "--json",
+    ];
+    args.extend_from_slice(extra);
+    let out = flapssm(&args);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
+#[test]
+fn restarts_are_independent_reproducible_and_combined_by_their_rule() {
+    let ens = short_actuator_run(&["--restarts", "2"]);
+    let run = &ens["runs"][0];
+    let restarts = run["restarts"].as_array().unwrap();
+    assert_eq!(restarts.len(), 2);
+    // Restart 0 keeps the seed; restart 1 trains from a different one.
+    assert_eq!(restarts[0]["train_seed"], 0);
+    assert_ne!(restarts[1]["train_seed"], 0);
+    assert!(run["selected_restart"].is_null());
+    // The mixture mean's RMSE is at most the mean of the members' (triangle inequality).
+    let member: Vec<f64> = restarts
+        .iter()
+        .map(|r| r["test"]["rmse"].as_f64().unwrap())
+        .collect();
+    let rmse = run["test"]["rmse"].as_f64().unwrap();
+    assert!(
+        rmse <= 0.5 * (member[0] + member[1]) + 1e-12,
+        "{rmse} {member:?}"
+    );
+    assert_ne!(member[0], member[1]);
+    // Same seed, same numbers.
+    assert_eq!(
+        short_actuator_run(&["--restarts", "2"])["runs"][0]["test"],
+        run["test"]
+    );
+    // Selection keeps the restart with the lowest training open-loop RMSE, and the restarts
+    // themselves do not depend on how they are combined.
+    let sel = short_actuator_run(&["--restarts", "2", "--combine", "select"]);
+    let sel_run = &sel["runs"][0];
+    assert_eq!(sel_run["restarts"], run["restarts"]);
+    let train: Vec<f64> = restarts
+        .iter()
+        .map(|r| r["best_train_rmse"].as_f64().unwrap())
+        .collect();
+    let best = usize::from(train[1] < train[0]);
+    assert_eq!(sel_run["selected_restart"], best);
+    assert_eq!(sel_run["test"], restarts[best]["test"]);
+    // One restart is the plain protocol: its only member is the reported result.
+    let single = short_actuator_run(&["--restarts", "1"]);
+    let single_run = &single["runs"][0];
+    assert_eq!(single_run["restarts"][0], restarts[0]);
+    assert_eq!(single_run["test"], restarts[0]["test"]);
+    let err = fails(&[
+        "sysid",
+        sysid_file("actuator.mat").to_str().unwrap(),
+        "--input",
+        "u",
+        "--output",
+        "p",
+        "--restarts",
+        "0",
+    ]);
+    assert!(err.contains("restarts"), "{err}");
+}

@@ -7,15 +7,18 @@
 //!   cross-correlation between a_x and the quasi-steady residual of F_x peaks 0.1–0.3 cycle
 //!   later.
 //!
-//! Both targets hold with a flat stroke plane (ψ = 0). On the default generator (ψ ≤ 40°) only
-//! the lag target holds: ω_z = α̇ + φ̇ sin ψ ≠ α̇, the trailing edge leads in ~6 % of the
-//! |v|²-weight (near reversals), and the 11 features cannot represent either, so L0 is fit only
-//! to ≈ 0.19 and the L1 ratio is ≈ 1.1. Those tests pin the measured values with a margin
-//! (see docs/virtual-wing.md); they are regression guards, not the issue-3 targets.
+//! All three targets hold for the Sane–Dickinson normal-force wing (chordwise skin friction
+//! only) on a flat stroke plane — the quasi-steady model the 11 features were designed for. The
+//! default wing adds the Dickinson chordwise coefficient C_T* and the chordwise Kirchhoff
+//! added-mass force −m_a ω_z(n + dω_z); with deviation, ω_z = α̇ + φ̇ sin ψ ≠ α̇. Neither is in
+//! the span of the 11 features (F_y and M_x are fit only to ≈ 1.0–1.15), so on the default wing
+//! and generator only the lag target holds; L0 (≈ 0.72) and the ratio (≈ 1.11) are pinned with
+//! a margin as regression guards, not as the issue-3 targets (see docs/virtual-wing.md).
 
 use faer::Mat;
 use faer::linalg::solvers::Solve;
 use flapssm_data::Dataset;
+use flapssm_wing::aero::quasi_steady::ChordwiseModel;
 use flapssm_wing::features::published_features;
 use flapssm_wing::sensor::SensorConfig;
 use flapssm_wing::trajectories::GeneratorConfig;
@@ -26,13 +29,27 @@ const N_TRAIN: usize = 56;
 /// First sample used (the published analysis drops 93; the history model needs 100).
 const SKIP: usize = 100;
 const SEED: u64 = 2021;
+/// L0 quasi-steady fit of the default wing on the default generator: measured 0.72, pinned with
+/// a margin.
+const L0_PIN: f64 = 0.8;
+/// L1 quasi-steady / history ratio there: measured 1.11, pinned with a margin.
+const RATIO_PIN: f64 = 1.05;
 /// Past samples seen by the history model (25 Hz): covers one cycle for f ≥ 0.25 Hz.
 const LAGS: [usize; 20] = [
     0, 1, 2, 3, 4, 6, 8, 10, 13, 16, 20, 25, 30, 36, 43, 50, 60, 70, 85, 100,
 ];
 
+/// Which loads the wing produces.
+#[derive(Clone, Copy, Debug)]
+enum Chordwise {
+    /// The default wing: Dickinson C_T* and the chordwise Kirchhoff added-mass force.
+    Full,
+    /// The Sane–Dickinson normal-force model: skin friction only along the chord.
+    FrictionOnly,
+}
+
 /// Small noise-free dataset: default generator, or a flat stroke plane (ψ = 0) if `flat`.
-fn dataset(fidelity: Fidelity, flat: bool) -> (Dataset, Vec<f64>) {
+fn dataset(fidelity: Fidelity, flat: bool, chordwise: Chordwise) -> (Dataset, Vec<f64>) {
     let defaults = GeneratorConfig::default();
     let trajectories = GeneratorConfig {
         n_trajectories: N_TRAJ,
@@ -51,14 +68,16 @@ fn dataset(fidelity: Fidelity, flat: bool) -> (Dataset, Vec<f64>) {
         .iter()
         .map(|s| s.frequency_hz)
         .collect();
-    let cfg = SimulationConfig {
-        wing: VirtualWingConfig {
-            fidelity,
-            sensor: SensorConfig::noise_free(),
-            ..Default::default()
-        },
-        trajectories,
+    let mut wing = VirtualWingConfig {
+        fidelity,
+        sensor: SensorConfig::noise_free(),
+        ..Default::default()
     };
+    if let Chordwise::FrictionOnly = chordwise {
+        wing.aero.quasi_steady.chordwise = ChordwiseModel::SkinFriction;
+        wing.aero.quasi_steady.added_mass_chordwise = false;
+    }
+    let cfg = SimulationConfig { wing, trajectories };
     (simulate_dataset(&cfg, &|| {}).unwrap(), freqs)
 }
 
@@ -234,11 +253,11 @@ struct Memory {
     median_lag_cycles: f64,
 }
 
-fn memory(flat: bool) -> Memory {
-    let label = if flat { "flat" } else { "default" };
-    let (ds0, _) = dataset(Fidelity::L0, flat);
+fn memory(flat: bool, chordwise: Chordwise) -> Memory {
+    let label = format!("{}, {chordwise:?}", if flat { "flat" } else { "default" });
+    let (ds0, _) = dataset(Fidelity::L0, flat, chordwise);
     let l0 = fit(&ds0, false);
-    let (ds, freqs) = dataset(Fidelity::L1, flat);
+    let (ds, freqs) = dataset(Fidelity::L1, flat, chordwise);
     let qs = fit(&ds, false);
     let hist = fit(&ds, true);
     let median_lag_cycles = median(xcorr_peak_lags(&ds, &freqs, &qs.residual_fx));
@@ -261,9 +280,11 @@ fn memory(flat: bool) -> Memory {
     }
 }
 
+/// The Sane–Dickinson normal-force wing (chordwise skin friction only) on a flat stroke plane
+/// meets all three targets: this is the quasi-steady model the 11 features were built for.
 #[test]
 fn flat_stroke_plane_meets_the_memory_targets() {
-    let m = memory(true);
+    let m = memory(true, Chordwise::FrictionOnly);
     assert!(m.qs_l0 < 0.1, "L0 QS test RMSE {}", m.qs_l0);
     let ratio = m.qs_l1 / m.history_l1;
     assert!(ratio >= 2.0, "ratio {ratio}");
@@ -271,22 +292,19 @@ fn flat_stroke_plane_meets_the_memory_targets() {
     assert!((0.1..=0.3).contains(&lag), "median lag {lag} cycle");
 }
 
-/// Default generator: the lag target holds; L0 and the ratio are pinned at their measured
-/// values (0.185, 1.08) with a margin — they fall short of the targets (< 0.1, ≥ 2).
+/// The default wing and generator: the lag target holds; the quasi-steady fit of L0 and the
+/// ratio are pinned at their measured values with a margin (see the module docs) — they fall
+/// short of the targets (< 0.1, ≥ 2) because the chordwise loads and ω_z ≠ α̇ lie outside
+/// the span of the 11 features, quasi-steady or not.
 #[test]
 fn default_trajectories_memory_evidence() {
-    let m = memory(false);
+    let m = memory(false, Chordwise::Full);
     let lag = m.median_lag_cycles;
     assert!((0.1..=0.3).contains(&lag), "median lag {lag} cycle");
-    assert!(m.qs_l0 < 0.21, "L0 QS test RMSE {}", m.qs_l0);
-    assert!(
-        m.qs_l1 > 1.4 * m.qs_l0,
-        "L1 QS {} vs L0 QS {}",
-        m.qs_l1,
-        m.qs_l0
-    );
+    assert!(m.qs_l0 < L0_PIN, "L0 QS test RMSE {}", m.qs_l0);
+    assert!(m.qs_l1 > m.qs_l0, "L1 QS {} vs L0 QS {}", m.qs_l1, m.qs_l0);
     let ratio = m.qs_l1 / m.history_l1;
-    assert!(ratio > 1.0, "ratio {ratio}");
+    assert!(ratio > RATIO_PIN, "ratio {ratio}");
 }
 
 /// The trailing edge leads (|AoA| > 90°) in only a small share of the |v|²-weight of the

@@ -2,8 +2,9 @@
 
 use flapssm_wing::aero::blade_element::{BladeElement, BladeGeometry};
 use flapssm_wing::aero::quasi_steady::{
-    QuasiSteadyParams, QuasiSteadySection, added_mass, centre_of_pressure_frac, dickinson_drag,
-    dickinson_lift, dickinson_normal, rotational_coefficient,
+    ChordwiseModel, QuasiSteadyParams, QuasiSteadySection, added_mass, blasius_skin_friction,
+    centre_of_pressure_frac, dickinson_drag, dickinson_lift, dickinson_normal,
+    dickinson_tangential, plate_tangential, rotational_coefficient, translational_coefficients,
 };
 use flapssm_wing::aero::unsteady::{UnsteadyParams, UnsteadySection};
 use flapssm_wing::aero::{SectionGeometry, SectionKinematics, SectionModel, SectionModelFactory};
@@ -120,6 +121,51 @@ fn blade_element_translation_matches_analytic_and_converges() {
             );
         }
     }
+}
+
+/// Chordwise loads: the physics notes' C_T table, the flat-plate symmetry (no chordwise force
+/// broadside on, continuity where t changes sign), the Re correction of the friction, and the
+/// Kirchhoff force −ω × (m_a n_m x̂) of a plate translating normal to itself while rotating.
+#[test]
+fn chordwise_loads() {
+    for (deg, c_t) in [(0.0, -0.393), (20.0, -0.165), (45.0, 0.071), (90.0, 0.101)] {
+        let a = f64::to_radians(deg);
+        assert!((dickinson_tangential(a) - c_t).abs() < 1e-3, "{deg}°");
+    }
+    assert!((plate_tangential(0.0) + 0.393).abs() < 1e-3);
+    assert!(plate_tangential(FRAC_PI_2).abs() < 1e-15);
+    assert!((blasius_skin_friction(1000.0) - 0.08399).abs() < 1e-4);
+    let params = QuasiSteadyParams::default();
+    assert_eq!(params.chordwise, ChordwiseModel::Dickinson);
+    // LE-first along the chord: drag, reduced by the friction moved from Re 150 to Re 1000.
+    let along = translational_coefficients(0.0, 1.0, &params);
+    let expected = -0.393 + blasius_skin_friction(150.0) - blasius_skin_friction(1000.0);
+    assert!((along.c_t - expected).abs() < 1e-3);
+    // Reversing t mirrors c_t; near broadside on it tends to zero from both sides.
+    for (n, t) in [(0.3, 0.7), (-0.5, 0.2), (1.0, 1e-9)] {
+        let a = translational_coefficients(n, t, &params);
+        let b = translational_coefficients(n, -t, &params);
+        assert!((a.c_t + b.c_t).abs() < 1e-15);
+        assert!((a.c_n - b.c_n).abs() < 1e-15);
+    }
+    assert!(translational_coefficients(1.0, 1e-9, &params).c_t.abs() < 1e-8);
+    let friction = QuasiSteadyParams {
+        chordwise: ChordwiseModel::SkinFriction,
+        ..params
+    };
+    let f = translational_coefficients(0.6, 0.8, &friction);
+    assert!((f.c_t + blasius_skin_friction(1000.0) * 0.8).abs() < 1e-12);
+    // Kirchhoff: n = 0.2 m/s, ω_z = 3 rad/s about the axis at 15 % chord, so the mid-chord
+    // normal velocity is n + (½ − x̂0)c·ω_z.
+    let kin = SectionKinematics {
+        normal_velocity_m_s: 0.2,
+        rotation_rate_rad_s: 3.0,
+        ..Default::default()
+    };
+    let m_a = PI / 4.0 * 800.0 * 0.06 * 0.06;
+    let n_mid = 0.2 + 0.35 * 0.06 * 3.0;
+    let l = added_mass(&section(), &kin);
+    assert!((l.chordwise_n_m + m_a * 3.0 * n_mid).abs() < 1e-12);
 }
 
 #[test]

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 use clap::Args;
-use flapssm_analysis::sysid::{IoRecord, SeedRun, SysidSpec, run as run_protocol};
+use flapssm_analysis::sysid::{Combine, IoRecord, SeedRun, SysidSpec, run as run_protocol};
 use flapssm_data::table::Column;
 use flapssm_prssm::train::LrSchedule;
 
@@ -27,6 +27,14 @@ pub struct SysidArgs {
     /// Number of seeds (0, 1, …), one fit each.
     #[arg(long, default_value_t = 3)]
     seeds: u64,
+    /// Independent fits per seed, run in parallel and combined (`--combine`).
+    #[arg(long, default_value_t = 2)]
+    restarts: usize,
+    /// How restarts are combined: `ensemble` (moment-matched mixture of their predictions)
+    /// `select` (lowest open-loop RMSE on the training part) or `snapshots` (mixture of the best and
+    /// last parameters of every restart).
+    #[arg(long, default_value = "ensemble", value_parser = parse_combine)]
+    combine: Combine,
     /// Optimizer steps per fit.
     #[arg(long, default_value_t = 3000)]
     iterations: u64,
@@ -47,9 +55,36 @@ pub struct SysidArgs {
     plot: Option<PathBuf>,
 }
 
+fn parse_combine(s: &str) -> Result<Combine, String> {
+    match s {
+        "ensemble" => Ok(Combine::Ensemble),
+        "select" => Ok(Combine::Select),
+        "snapshots" => Ok(Combine::Snapshots),
+        _ => Err(format!(
+            "unknown combination {s:?} (expected ensemble, select or snapshots)"
+        )),
+    }
+}
+
 fn print_run(r: &SeedRun) {
+    let members = match r.restarts.len() {
+        1 => String::new(),
+        _ => format!(
+            "  (restarts: train RMSE {}; test RMSE {})",
+            r.restarts
+                .iter()
+                .map(|x| format!("{:.3}", x.best_train_rmse.unwrap_or(f64::NAN)))
+                .collect::<Vec<_>>()
+                .join(", "),
+            r.restarts
+                .iter()
+                .map(|x| format!("{:.4}", x.test.rmse))
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
+    };
     println!(
-        "seed {:>2}: test RMSE {:.4}  NLL {:.3}  wall {:.1} s{}{}",
+        "seed {:>2}: test RMSE {:.4}  NLL {:.3}  wall {:.1} s{members}{}{}",
         r.seed,
         r.test.rmse,
         r.test.nll,
@@ -72,6 +107,8 @@ pub fn run(args: SysidArgs) -> anyhow::Result<()> {
     let mut spec = SysidSpec {
         split: args.split,
         seeds: args.seeds,
+        restarts: args.restarts,
+        combine: args.combine,
         ..SysidSpec::reference(args.inputs.len(), args.outputs.len())
     }
     .with_iterations(args.iterations);

@@ -5,9 +5,11 @@
 //! α_g = atan2(|n|, |t|) ∈ [0, π/2]:
 //!
 //! - translation: N_tr = −sgn(n)·k_N·C_N*(α_g)·q acting at x_cp = x̂_cp(α_g)·c behind the
-//!   leading side (the LE when t ≥ 0, the TE otherwise); chordwise only skin friction,
-//!   T_tr = −C_f·q·t/U (the separated-flow force is normal to the plate: no leading-edge
-//!   suction). C_f = 2·1.328/√Re (Blasius, both faces) at the nominal Re = 1000: 0.084;
+//!   leading side (the LE when t ≥ 0, the TE otherwise), and the chordwise force
+//!   T_tr = sgn(t)·[k_N·C_T*(α_g) + (C_f,fit − C_f)·cos α_g]·q, positive towards the leading
+//!   side. C_T* is the Dickinson tangential coefficient (drag at low α, a weak suction at
+//!   mid α); the friction it holds is moved from the fits' Re ≈ 150 (Blasius, both faces:
+//!   C_f,fit = 2·1.328/√150 = 0.217) to this wing's Re = 1000 (C_f = 0.084);
 //! - rotation: N_rot = πρc²ω_z[(x̂0 − ½)U − ¼t], applied at mid-chord. For LE-first motion
 //!   along the chord (t = U) this is the Sane–Dickinson force −C_rot ρ c² U ω_z with
 //!   C_rot = π(¾ − x̂0); the ¼t term moves the ¾-chord point continuously to the other side
@@ -15,13 +17,16 @@
 //! - added mass (Kirchhoff, 2-D flat plate, m_a = πρc²/4, d = (½ − x̂0)c, mid-chord normal
 //!   velocity n_m = n + dω_z): N_am = −m_a(ṅ + dω̇_z), M_am = −m_a[dṅ + (d² + c²/32)ω̇_z]
 //!   (the physics notes' strip form). The steady Munk moment is left out (the measured
-//!   x̂_cp(α) already contains the steady moment); the chordwise Kirchhoff term
-//!   T_am = −m_a ω_z n_m is off by default, as in the Sane–Dickinson model, and can be switched on.
+//!   x̂_cp(α) already contains the steady moment). The chordwise Kirchhoff force
+//!   T_am = −m_a ω_z n_m (−ω × impulse of the normal added mass) is on by default: the
+//!   Sane–Dickinson model keeps only normal forces, but the plate's chordwise load at
+//!   reversal is dominated by this term (the LRQSM features α̇·v_x, α̇·|α̇| mirror it).
 //!
-//! C_N* is the Dickinson fit with its offset at 0° removed, C_N*(α) = C_N(α) − C_N(0) cos α,
-//! so that a flat plate gets no normal force at zero incidence (the load stays continuous where
-//! n changes sign); C_N*(90°) = C_N(90°). The Dickinson C_T (−0.39 at 0°) is not used: it
-//! holds the Re ≈ 150 drag of the fits, not the Re ≈ 1000 friction of this wing.
+//! C_N* and C_T* are the Dickinson fits with the offsets a symmetric flat plate cannot have
+//! removed: C_N*(α) = C_N(α) − C_N(0) cos α (no normal force at zero incidence) and
+//! C_T*(α) = C_T(α) − C_T(90°) sin α (no chordwise force broadside on), so the loads stay
+//! continuous where n or t changes sign. [`ChordwiseModel::SkinFriction`] keeps only the
+//! friction, T_tr = −C_f·q·t/U.
 
 use super::{SectionGeometry, SectionKinematics, SectionLoads, SectionModel, SectionModelFactory};
 use serde::{Deserialize, Serialize};
@@ -53,6 +58,18 @@ pub fn plate_normal(aoa_rad: f64) -> f64 {
     dickinson_normal(aoa_rad) - dickinson_normal(0.0) * aoa_rad.cos()
 }
 
+/// Flat-plate tangential coefficient C_T*(α) = C_T(α) − C_T(π/2) sin α, α ∈ [0, π/2] (rad),
+/// positive towards the leading side: −0.393 at 0°, 0 at 90°.
+pub fn plate_tangential(aoa_rad: f64) -> f64 {
+    dickinson_tangential(aoa_rad) - dickinson_tangential(0.5 * PI) * aoa_rad.sin()
+}
+
+/// Laminar skin-friction coefficient of a plate wetted on both faces, C_f = 2·1.328/√Re
+/// (Blasius).
+pub fn blasius_skin_friction(reynolds: f64) -> f64 {
+    2.0 * 1.328 / reynolds.sqrt()
+}
+
 /// Chordwise centre of pressure x̂_cp(α) = 0.82|α|/π + 0.05, fraction of the chord behind
 /// the leading side.
 pub fn centre_of_pressure_frac(aoa_rad: f64) -> f64 {
@@ -64,19 +81,34 @@ pub fn rotational_coefficient(pitch_axis_frac: f64) -> f64 {
     PI * (0.75 - pitch_axis_frac)
 }
 
+/// The chordwise translational force model.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ChordwiseModel {
+    /// Dickinson tangential coefficient C_T*, friction moved to this wing's Re (default).
+    Dickinson,
+    /// Skin friction only, −C_f·q·t/U (no pressure drag, no suction).
+    SkinFriction,
+}
+
 /// Settings of the quasi-steady model.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct QuasiSteadyParams {
     /// Scale k_N of the translational coefficients (Re ≈ 1000, AR = 3 nuisance factor; 1.0).
     pub translational_scale: f64,
-    /// Skin-friction coefficient C_f of the chordwise force (0.084 = Blasius at Re = 1000).
+    /// Chordwise translational force model (Dickinson).
+    pub chordwise: ChordwiseModel,
+    /// Skin-friction coefficient C_f at this wing's Re (0.084 = Blasius at Re = 1000).
     pub skin_friction: f64,
+    /// Skin-friction coefficient C_f,fit contained in the Dickinson fits (0.217 = Blasius at
+    /// Re = 150).
+    pub fit_skin_friction: f64,
     /// Include the rotational circulation force (true).
     pub rotational: bool,
     /// Include the added-mass loads (true).
     pub added_mass: bool,
-    /// Include the chordwise Kirchhoff added-mass force T_am = −m_a ω_z n_m (false).
+    /// Include the chordwise Kirchhoff added-mass force T_am = −m_a ω_z n_m (true).
     pub added_mass_chordwise: bool,
 }
 
@@ -84,10 +116,12 @@ impl Default for QuasiSteadyParams {
     fn default() -> Self {
         Self {
             translational_scale: 1.0,
-            skin_friction: 2.0 * 1.328 / 1000f64.sqrt(),
+            chordwise: ChordwiseModel::Dickinson,
+            skin_friction: blasius_skin_friction(1000.0),
+            fit_skin_friction: blasius_skin_friction(150.0),
             rotational: true,
             added_mass: true,
-            added_mass_chordwise: false,
+            added_mass_chordwise: true,
         }
     }
 }
@@ -104,19 +138,26 @@ pub struct TranslationalCoefficients {
     pub cp_from_le: f64,
 }
 
-/// Translational coefficients for a section moving with (n, t) (m/s) relative to the fluid:
-/// normal scaled by k_N = `scale`, chordwise friction C_f = `skin_friction`.
+/// Translational coefficients for a section moving with (n, t) (m/s) relative to the fluid
+/// (see the module docs for the equations).
 pub fn translational_coefficients(
     normal_m_s: f64,
     chord_m_s: f64,
-    scale: f64,
-    skin_friction: f64,
+    params: &QuasiSteadyParams,
 ) -> TranslationalCoefficients {
     let aoa_g = normal_m_s.abs().atan2(chord_m_s.abs());
     let cp = centre_of_pressure_frac(aoa_g);
+    let scale = params.translational_scale;
+    let c_t = match params.chordwise {
+        ChordwiseModel::Dickinson => {
+            scale * plate_tangential(aoa_g)
+                + (params.fit_skin_friction - params.skin_friction) * aoa_g.cos()
+        }
+        ChordwiseModel::SkinFriction => -params.skin_friction * aoa_g.cos(),
+    };
     TranslationalCoefficients {
         c_n: -signum0(normal_m_s) * scale * plate_normal(aoa_g),
-        c_t: -skin_friction * signum0(chord_m_s) * aoa_g.cos(),
+        c_t: signum0(chord_m_s) * c_t,
         cp_from_le: if chord_m_s >= 0.0 { cp } else { 1.0 - cp },
     }
 }
@@ -229,12 +270,7 @@ impl QuasiSteadySection {
     /// Loads for the given kinematics (no memory).
     pub fn loads(&self, kin: &SectionKinematics) -> SectionLoads {
         let (n, t) = (kin.normal_velocity_m_s, kin.chord_velocity_m_s);
-        let coeffs = translational_coefficients(
-            n,
-            t,
-            self.params.translational_scale,
-            self.params.skin_friction,
-        );
+        let coeffs = translational_coefficients(n, t, &self.params);
         let circ = circulatory_loads(
             &self.geom,
             &self.params,

@@ -217,12 +217,7 @@ impl SectionModel for UnsteadySection {
 
         // Attached (potential) share of the translational force, w_att = cos²α_g; the rest is
         // the LEV share.
-        let mut coeffs = translational_coefficients(
-            n_rel,
-            t_rel,
-            p.quasi_steady.translational_scale,
-            p.quasi_steady.skin_friction,
-        );
+        let mut coeffs = translational_coefficients(n_rel, t_rel, &p.quasi_steady);
         let cos2 = if speed > 0.0 {
             t_rel * t_rel / (speed * speed)
         } else {
