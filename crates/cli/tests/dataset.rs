@@ -1,7 +1,11 @@
 //! `flapssm dataset …` end to end: import, info, export, round trip, and bad input.
 
+mod common;
+
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+
+use common::{assert_fails, flapssm, s};
+use std::process::Output;
 
 use flapssm_data::Dataset;
 use flapssm_data::npz::{NpyData, NpzReader, NpzWriter};
@@ -10,17 +14,6 @@ fn fixture(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../data/tests/fixtures")
         .join(name)
-}
-
-fn flapssm(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_flapssm"))
-        .args(args)
-        .output()
-        .expect("run flapssm")
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
 }
 
 /// Imports the 4 × 40 scipy fixture with 3 training trajectories.
@@ -38,24 +31,6 @@ fn imported(dir: &Path) -> PathBuf {
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     out
-}
-
-/// Asserts failure, a message naming each of `needles`, and that `out` was not created
-/// (nor any temporary file left in its directory).
-fn assert_fails(o: &Output, needles: &[&str], out: &Path) {
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert!(!o.status.success(), "succeeded; stderr: {err}");
-    for n in needles {
-        assert!(err.contains(n), "stderr lacks {n:?}: {err}");
-    }
-    assert!(!err.contains("panicked"), "{err}");
-    assert!(!out.exists(), "{} was written", out.display());
-    let leftovers: Vec<_> = std::fs::read_dir(out.parent().unwrap())
-        .unwrap()
-        .filter_map(|e| e.ok())
-        .filter(|e| e.file_name().to_string_lossy().ends_with(".tmp"))
-        .collect();
-    assert!(leftovers.is_empty(), "temporary files left: {leftovers:?}");
 }
 
 #[test]

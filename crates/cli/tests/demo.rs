@@ -3,30 +3,9 @@
 //! `evaluate` reproduces the demo's numbers from the written files, sweeps run and merge, and
 //! bad input gives a clear error and a nonzero exit.
 
-use std::path::Path;
-use std::process::{Command, Output};
+mod common;
 
-fn flapssm(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_flapssm"))
-        .args(args)
-        .output()
-        .expect("run flapssm")
-}
-
-fn ok(args: &[&str]) -> String {
-    let o = flapssm(args);
-    assert!(
-        o.status.success(),
-        "flapssm {args:?} failed:\n{}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    String::from_utf8_lossy(&o.stdout).into_owned()
-}
-
-fn json(path: &Path) -> serde_json::Value {
-    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    serde_json::from_str(&text).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
-}
+use common::{flapssm, json, ok};
 
 fn floats(v: &serde_json::Value) -> Vec<f64> {
     v.as_array()

@@ -1,23 +1,18 @@
 //! `flapssm qs …` end to end: scikit-learn conformance through `fit-csv --json`, a dataset
 //! fit/predict round trip, and bad input.
 
+mod common;
+
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+
+use common::flapssm;
 
 use flapssm_data::npz::NpzReader;
 use flapssm_data::{Dataset, DatasetMeta, Trajectory};
 use flapssm_wing::features::published_features;
 
-fn flapssm(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_flapssm"))
-        .args(args)
-        .output()
-        .expect("run flapssm")
-}
-
 fn reference() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../../shared/reference/elastic-net/reference.npz")
+    common::reference("elastic-net/reference.npz")
 }
 
 fn max_abs_diff(a: &[f64], b: &[f64]) -> f64 {

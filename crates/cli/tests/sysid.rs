@@ -1,15 +1,11 @@
 //! `flapssm sysid …`: bad input fails with a clear message and a nonzero exit; one short
 //! end-to-end run on the hydraulic-actuator benchmark beats the training-mean predictor.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
 
-fn flapssm(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_flapssm"))
-        .args(args)
-        .output()
-        .expect("run flapssm")
-}
+use std::path::{Path, PathBuf};
+
+use common::flapssm;
 
 fn sysid_file(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))

@@ -8,7 +8,7 @@ use std::io::{BufRead, BufReader};
 use std::path::Path;
 use std::process::{Command, Stdio};
 
-use common::{assert_fails, flapssm, ok, s, simulated};
+use common::{assert_fails, flapssm, json, ok, s, simulated};
 use flapssm_prssm::PrssmModel;
 
 const EPOCHS: &str = "60";
@@ -35,10 +35,6 @@ fn train_args<'a>(data: &'a Path, out: &'a Path, epochs: &'a str) -> Vec<&'a str
         "--checkpoint-every",
         "5",
     ]
-}
-
-fn json(path: &Path) -> serde_json::Value {
-    serde_json::from_slice(&std::fs::read(path).unwrap()).unwrap()
 }
 
 /// Runs training, sends SIGINT once the first epoch is reported, and waits.
