@@ -346,45 +346,8 @@ impl ConditionalWorkspace {
             view(w, m, n),
             1.0,
         );
-        match post.cov {
-            CovarianceStructure::Diagonal => {
-                for (w2, &wv) in self.w2[..m * n].iter_mut().zip(w) {
-                    *w2 = wv * wv;
-                }
-                gemm(
-                    view_mut(&mut self.var, dx, n),
-                    Accum::Replace,
-                    view(&post.q_cov, dx, m),
-                    view(&self.w2, m, n),
-                    1.0,
-                )
-            }
-            CovarianceStructure::Full => {
-                for dd in 0..dx {
-                    let ld = &post.q_cov[dd * m * m..(dd + 1) * m * m];
-                    gemm(
-                        view_mut(&mut self.w2, m, n),
-                        Accum::Replace,
-                        view(ld, m, m).transpose(),
-                        view(w, m, n),
-                        1.0,
-                    );
-                    for j in 0..n {
-                        let c = &self.w2[j * m..(j + 1) * m];
-                        self.var[j * dx + dd] = dot(c, c);
-                    }
-                }
-            }
-        }
-        let h = if post.whitened { w } else { &*t.k };
-        for ((wc, hc), v) in w
-            .chunks_exact(m)
-            .zip(h.chunks_exact(m))
-            .zip(self.var.chunks_exact_mut(dx))
-        {
-            let base = post.variance - dot(wc, hc);
-            v.iter_mut().for_each(|v| *v += base);
-        }
+        let k = if post.whitened { None } else { Some(&*t.k) };
+        write_predictive_variance(post, w, m, k, n, &mut self.w2, &mut self.var);
     }
 
     /// Reverse mode of the last [`Self::forward`] on `n` points: given `mean_bar`, `var_bar`
@@ -679,49 +642,66 @@ impl PredictiveWorkspace {
             view(&self.k, m, n),
             1.0,
         );
-        let w = view(&self.wm, r, n).subrows(0, m);
-        match post.cov {
-            CovarianceStructure::Diagonal => {
-                for (w2, wc) in self.w2[..m * n].chunks_exact_mut(m).zip(self.wm.chunks(r)) {
-                    w2.iter_mut().zip(&wc[..m]).for_each(|(a, &b)| *a = b * b);
-                }
+        let k = if post.whitened {
+            None
+        } else {
+            Some(&self.k[..])
+        };
+        write_predictive_variance(post, &self.wm, r, k, n, &mut self.w2, &mut self.var);
+    }
+}
+
+/// Writes the predictive variances of `n` points into `var` (`D_x × N`, column-major):
+/// `σ²_d(n) = k** − w_nᵀh_n + Σ_i S_d,ii w_in²` (diagonal `S`) or `+ ‖L_dᵀw_n‖²` (full
+/// `S_d = L_dL_dᵀ`), with `w_n` the first `M` entries of column `n` of `w` (column stride
+/// `stride ≥ M`) and `h_n = k_n` (column `n` of `k`, `M × N`) or `w_n` when `k` is `None`
+/// (whitened). `w2` (`M × N`) is scratch. Allocates nothing.
+fn write_predictive_variance(
+    post: &Posterior,
+    w: &[f64],
+    stride: usize,
+    k: Option<&[f64]>,
+    n: usize,
+    w2: &mut [f64],
+    var: &mut [f64],
+) {
+    let (m, dx) = (post.m, post.dx);
+    let w_view = view(&w[..stride * n], stride, n).subrows(0, m);
+    match post.cov {
+        CovarianceStructure::Diagonal => {
+            for (c2, wc) in w2[..m * n].chunks_exact_mut(m).zip(w.chunks(stride)) {
+                c2.iter_mut().zip(&wc[..m]).for_each(|(a, &b)| *a = b * b);
+            }
+            gemm(
+                view_mut(var, dx, n),
+                Accum::Replace,
+                view(&post.q_cov, dx, m),
+                view(w2, m, n),
+                1.0,
+            )
+        }
+        CovarianceStructure::Full => {
+            for dd in 0..dx {
+                let ld = &post.q_cov[dd * m * m..(dd + 1) * m * m];
                 gemm(
-                    view_mut(&mut self.var, dx, n),
+                    view_mut(w2, m, n),
                     Accum::Replace,
-                    view(&post.q_cov, dx, m),
-                    view(&self.w2, m, n),
+                    view(ld, m, m).transpose(),
+                    w_view,
                     1.0,
-                )
-            }
-            CovarianceStructure::Full => {
-                for dd in 0..dx {
-                    let ld = &post.q_cov[dd * m * m..(dd + 1) * m * m];
-                    gemm(
-                        view_mut(&mut self.w2, m, n),
-                        Accum::Replace,
-                        view(ld, m, m).transpose(),
-                        w,
-                        1.0,
-                    );
-                    for j in 0..n {
-                        let c = &self.w2[j * m..(j + 1) * m];
-                        self.var[j * dx + dd] = dot(c, c);
-                    }
+                );
+                for j in 0..n {
+                    let c = &w2[j * m..(j + 1) * m];
+                    var[j * dx + dd] = dot(c, c);
                 }
             }
         }
-        for j in 0..n {
-            let wc = &self.wm[j * r..j * r + m];
-            let hc = if post.whitened {
-                wc
-            } else {
-                &self.k[j * m..(j + 1) * m]
-            };
-            let base = post.variance - dot(wc, hc);
-            self.var[j * dx..(j + 1) * dx]
-                .iter_mut()
-                .for_each(|v| *v += base);
-        }
+    }
+    for (j, v) in var[..dx * n].chunks_exact_mut(dx).enumerate() {
+        let wc = &w[j * stride..j * stride + m];
+        let hc = k.map_or(wc, |k| &k[j * m..(j + 1) * m]);
+        let base = post.variance - dot(wc, hc);
+        v.iter_mut().for_each(|v| *v += base);
     }
 }
 
