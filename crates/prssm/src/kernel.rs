@@ -163,10 +163,7 @@ pub(crate) fn cross_cov_grouped(
         .zip(kd.chunks_mut(m_n * group))
         .zip(xs.chunks(d * group))
     {
-        sq_dist(zt, m_n, shared_from, &xg[shared_from..d], None, tau_shared);
-        for (kc, x) in kg.chunks_exact_mut(m_n).zip(xg.chunks_exact(d)) {
-            sq_dist(zt, m_n, 0, &x[..shared_from], Some(tau_shared), kc);
-        }
+        group_sq_dist(zt, m_n, d, shared_from, xg, tau_shared, kg);
         apply_shape(kind, variance, matern_tau_jitter, kg, kdg);
     }
 }
@@ -187,12 +184,28 @@ pub(crate) fn cross_cov_grouped_values(
     let m_n = zt.len() / d;
     let tau_shared = &mut tau_shared[..m_n];
     for (kg, xg) in k.chunks_mut(m_n * group).zip(xs.chunks(d * group)) {
-        sq_dist(zt, m_n, shared_from, &xg[shared_from..d], None, tau_shared);
-        for (kc, x) in kg.chunks_exact_mut(m_n).zip(xg.chunks_exact(d)) {
-            sq_dist(zt, m_n, 0, &x[..shared_from], Some(tau_shared), kc);
-        }
+        group_sq_dist(zt, m_n, d, shared_from, xg, tau_shared, kg);
         // Over the whole group: one vector loop without per-column scalar tails.
         apply_shape_values(kind, variance, matern_tau_jitter, kg);
+    }
+}
+
+/// Squared scaled distances of one group of points `xg` (`D × group`) to the `M` inducing
+/// points into `kg` (`M × group`): the shared coordinates `shared_from..D` (the group's first
+/// point) once into `tau_shared`, then each point's own coordinates `0..shared_from` on top.
+#[inline(always)]
+fn group_sq_dist(
+    zt: &[f64],
+    m_n: usize,
+    d: usize,
+    shared_from: usize,
+    xg: &[f64],
+    tau_shared: &mut [f64],
+    kg: &mut [f64],
+) {
+    sq_dist(zt, m_n, shared_from, &xg[shared_from..d], None, tau_shared);
+    for (kc, x) in kg.chunks_exact_mut(m_n).zip(xg.chunks_exact(d)) {
+        sq_dist(zt, m_n, 0, &x[..shared_from], Some(tau_shared), kc);
     }
 }
 
