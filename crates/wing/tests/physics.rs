@@ -1,6 +1,10 @@
 //! Physics validation of the virtual wing (physics notes §4.4), noise-free.
 
-use flapssm_wing::aero::blade_element::{BladeElement, BladeGeometry};
+mod common;
+
+use common::{blade, robofly_hover_state};
+
+use flapssm_wing::aero::blade_element::BladeElement;
 use flapssm_wing::aero::quasi_steady::{
     ChordwiseModel, QuasiSteadyParams, QuasiSteadySection, added_mass, blasius_skin_friction,
     centre_of_pressure_frac, dickinson_drag, dickinson_lift, dickinson_normal,
@@ -17,17 +21,6 @@ fn section() -> SectionGeometry {
         pitch_axis_frac: 0.15,
         radius_m: 0.178,
         density_kg_m3: 800.0,
-    }
-}
-
-fn blade() -> BladeGeometry {
-    BladeGeometry {
-        span_m: 0.18,
-        chord_m: 0.06,
-        root_offset_m: 0.055,
-        pitch_axis_frac: 0.15,
-        density_kg_m3: 800.0,
-        sensor_radius_m: 0.055,
     }
 }
 
@@ -421,22 +414,8 @@ fn time_scaling_invariance() {
 /// C_N ≈ 2.5.
 #[test]
 fn hovering_sanity() {
-    let (f, amp, a_pitch, k) = (0.3, 80f64.to_radians(), FRAC_PI_4, 3.0);
-    let w = 2.0 * PI * f;
-    let state = |t: f64| {
-        let x = w * t;
-        let u = k * x.cos();
-        let (u1, u2) = (-k * x.sin() * w, -k * x.cos() * w * w);
-        let g = u.tanh();
-        let g1 = (1.0 - g * g) * u1;
-        let g2 = (1.0 - g * g) * u2 - 2.0 * g * (1.0 - g * g) * u1 * u1;
-        let s = -a_pitch / k.tanh();
-        EulerState {
-            angles_rad: [amp * x.sin(), 0.0, s * g],
-            rates_rad_s: [amp * w * x.cos(), 0.0, s * g1],
-            accels_rad_s2: [-amp * w * w * x.sin(), 0.0, s * g2],
-        }
-    };
+    let (f, amp) = (0.3, 80f64.to_radians());
+    let state = |t: f64| robofly_hover_state(t, f);
     let dt = 1.0 / f / 800.0;
     let per_cycle = 800;
     let n = 6 * per_cycle;

@@ -1,6 +1,9 @@
 //! Checks of the L2 vortex method against analytic values (Wagner, Theodorsen), the canonical
 //! LDVM pitch-up, conservation laws and invariances.
 
+mod common;
+
+use common::{blade, robofly_hover_state};
 use std::f64::consts::PI;
 
 use flapssm_wing::vortex::{Ldvm, LdvmParams, PlateState, SectionLoads, VortexKind};
@@ -644,42 +647,11 @@ fn study_hover_spikes() {
 // ---------------------------------------------------------------------------------------------
 // Wing level: the strip LDVM through the blade-element integrator.
 
-use flapssm_wing::aero::blade_element::{BladeElement, BladeGeometry};
+use flapssm_wing::aero::blade_element::BladeElement;
 use flapssm_wing::aero::quasi_steady::{QuasiSteadyParams, QuasiSteadySection};
 use flapssm_wing::aero::{SectionGeometry, SectionKinematics, SectionModel};
 use flapssm_wing::kinematics::{EulerState, WingKinematics, rotation_global_from_wing};
 use flapssm_wing::vortex::{StripLdvm, StripLdvmFactory, StripLdvmParams};
-
-/// The dataset plate: 0.18 × 0.06 m, r0 = 0.055 m, pitch axis 15 %, oil, sensor at the root.
-fn blade() -> BladeGeometry {
-    BladeGeometry {
-        span_m: 0.18,
-        chord_m: 0.06,
-        root_offset_m: 0.055,
-        pitch_axis_frac: 0.15,
-        density_kg_m3: 800.0,
-        sensor_radius_m: 0.055,
-    }
-}
-
-/// Robofly-like hovering (as in tests/physics.rs): φ = 80° sin(2πft), ψ = 0, α = ∓45° at
-/// mid-stroke with a tanh-shaped rotation of sharpness `k` = 3, scaled in time by `f`.
-fn hover_state(t: f64, f: f64) -> EulerState {
-    let (amp, a_pitch, k) = (80f64.to_radians(), PI / 4.0, 3.0);
-    let w = 2.0 * PI * f;
-    let x = w * t;
-    let u = k * x.cos();
-    let (u1, u2) = (-k * x.sin() * w, -k * x.cos() * w * w);
-    let g = u.tanh();
-    let g1 = (1.0 - g * g) * u1;
-    let g2 = (1.0 - g * g) * u2 - 2.0 * g * (1.0 - g * g) * u1 * u1;
-    let s = -a_pitch / k.tanh();
-    EulerState {
-        angles_rad: [amp * x.sin(), 0.0, s * g],
-        rates_rad_s: [amp * w * x.cos(), 0.0, s * g1],
-        accels_rad_s2: [-amp * w * w * x.sin(), 0.0, s * g2],
-    }
-}
 
 /// Runs the L2 blade element (`n_strips` strips) over `states` sampled every `dt`.
 fn run_blade(states: &[EulerState], dt: f64, n_strips: usize) -> Vec<[f64; 5]> {
@@ -703,7 +675,12 @@ const PER_CYCLE: usize = 500;
 fn hover_states(f: f64, cycles: usize) -> (Vec<EulerState>, f64) {
     let dt = 1.0 / f / PER_CYCLE as f64;
     let n = cycles * PER_CYCLE;
-    ((0..n).map(|i| hover_state(i as f64 * dt, f)).collect(), dt)
+    (
+        (0..n)
+            .map(|i| robofly_hover_state(i as f64 * dt, f))
+            .collect(),
+        dt,
+    )
 }
 
 /// (φ, ψ, α) → (−φ, ψ, −α) mirrors the wing frame in x_w: F_x, M_y, M_z change sign, F_y and

@@ -1,0 +1,38 @@
+//! Fixtures shared by the wing's integration tests.
+#![allow(dead_code)]
+
+use flapssm_wing::aero::blade_element::BladeGeometry;
+use flapssm_wing::kinematics::EulerState;
+use std::f64::consts::{FRAC_PI_4, PI};
+
+/// The dataset plate: 0.18 × 0.06 m, r0 = 0.055 m, pitch axis 15 %, oil, sensor at the root.
+pub fn blade() -> BladeGeometry {
+    BladeGeometry {
+        span_m: 0.18,
+        chord_m: 0.06,
+        root_offset_m: 0.055,
+        pitch_axis_frac: 0.15,
+        density_kg_m3: 800.0,
+        sensor_radius_m: 0.055,
+    }
+}
+
+/// Robofly-like hovering at `f` Hz: φ = 80° sin(2πft), ψ = 0, α = ∓45° at mid-stroke with a
+/// tanh-shaped rotation of sharpness k = 3 (AoA = 45° at mid-stroke); analytic rates and
+/// accelerations.
+pub fn robofly_hover_state(t: f64, f: f64) -> EulerState {
+    let (amp, a_pitch, k) = (80f64.to_radians(), FRAC_PI_4, 3.0);
+    let w = 2.0 * PI * f;
+    let x = w * t;
+    let u = k * x.cos();
+    let (u1, u2) = (-k * x.sin() * w, -k * x.cos() * w * w);
+    let g = u.tanh();
+    let g1 = (1.0 - g * g) * u1;
+    let g2 = (1.0 - g * g) * u2 - 2.0 * g * (1.0 - g * g) * u1 * u1;
+    let s = -a_pitch / k.tanh();
+    EulerState {
+        angles_rad: [amp * x.sin(), 0.0, s * g],
+        rates_rad_s: [amp * w * x.cos(), 0.0, s * g1],
+        accels_rad_s2: [-amp * w * w * x.sin(), 0.0, s * g2],
+    }
+}
