@@ -67,7 +67,7 @@ pub enum SimulateError {
         /// The name given.
         name: String,
     },
-    /// The fidelity has no section model in this build.
+    /// The fidelity is not dispatched (its model does not yet meet its validation).
     #[error("fidelity {fidelity:?} is not available: {reason}")]
     FidelityUnavailable {
         /// The fidelity asked for.
@@ -210,7 +210,8 @@ impl VirtualWingConfig {
             Fidelity::L1 => Ok(Box::new(self.aero)),
             Fidelity::L2 => Err(SimulateError::FidelityUnavailable {
                 fidelity: Fidelity::L2,
-                reason: "the vortex strip model does not implement SectionModelFactory yet",
+                reason: "the strip vortex model (vortex::StripLdvmFactory) is not yet stable over repeated \
+                         stroke reversals (docs/vortex-method.md, Known gaps)",
             }),
         }
     }
