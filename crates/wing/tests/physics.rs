@@ -2,7 +2,7 @@
 
 mod common;
 
-use common::{blade, robofly_hover_state};
+use common::{blade, mirrored, robofly_hover_state};
 
 use flapssm_wing::aero::blade_element::BladeElement;
 use flapssm_wing::aero::quasi_steady::{
@@ -339,17 +339,7 @@ fn generated_states(dt_s: f64, n: usize) -> Vec<EulerState> {
 fn mirror_symmetry() {
     let dt = 0.004;
     let states = generated_states(dt, 2000);
-    let mirrored: Vec<EulerState> = states
-        .iter()
-        .map(|s| {
-            let m = |v: [f64; 3]| [-v[0], v[1], -v[2]];
-            EulerState {
-                angles_rad: m(s.angles_rad),
-                rates_rad_s: m(s.rates_rad_s),
-                accels_rad_s2: m(s.accels_rad_s2),
-            }
-        })
-        .collect();
+    let mirrored = mirrored(&states);
     for fidelity in [Fidelity::L0, Fidelity::L1] {
         let mut w = wing(fidelity);
         let mut a = vec![[0.0; 5]; states.len()];

@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::{blade, robofly_hover_state};
+use common::{blade, mirrored, robofly_hover_state};
 use std::f64::consts::PI;
 
 use flapssm_wing::vortex::{Ldvm, LdvmParams, PlateState, SectionLoads, VortexKind};
@@ -688,17 +688,7 @@ fn hover_states(f: f64, cycles: usize) -> (Vec<EulerState>, f64) {
 #[test]
 fn wing_l2_mirror_symmetry() {
     let (states, dt) = hover_states(F_HOVER, 2);
-    let mirrored: Vec<EulerState> = states
-        .iter()
-        .map(|s| {
-            let m = |v: [f64; 3]| [-v[0], v[1], -v[2]];
-            EulerState {
-                angles_rad: m(s.angles_rad),
-                rates_rad_s: m(s.rates_rad_s),
-                accels_rad_s2: m(s.accels_rad_s2),
-            }
-        })
-        .collect();
+    let mirrored = mirrored(&states);
     let a = run_blade(&states, dt, 2);
     let b = run_blade(&mirrored, dt, 2);
     let sign = [-1.0, 1.0, 1.0, -1.0, -1.0];

@@ -36,3 +36,17 @@ pub fn robofly_hover_state(t: f64, f: f64) -> EulerState {
         accels_rad_s2: [-amp * w * w * x.sin(), 0.0, s * g2],
     }
 }
+
+/// (φ, ψ, α) → (−φ, ψ, −α): the kinematics mirrored in the wing frame's x_w (F_x, M_y, M_z
+/// change sign, F_y and M_x do not).
+pub fn mirrored(states: &[EulerState]) -> Vec<EulerState> {
+    let m = |v: [f64; 3]| [-v[0], v[1], -v[2]];
+    states
+        .iter()
+        .map(|s| EulerState {
+            angles_rad: m(s.angles_rad),
+            rates_rad_s: m(s.rates_rad_s),
+            accels_rad_s2: m(s.accels_rad_s2),
+        })
+        .collect()
+}
