@@ -20,7 +20,7 @@ fn tiny_demo_evaluate_and_sweep() {
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path().join("demo");
     let d = dir.to_str().unwrap();
-    ok(&[
+    let run = [
         "demo",
         "--out",
         d,
@@ -30,7 +30,8 @@ fn tiny_demo_evaluate_and_sweep() {
         "3",
         "--seed",
         "5",
-    ]);
+    ];
+    ok(&run);
 
     // summary.json: headline numbers, consistent with each other.
     let s = json(&dir.join("summary.json"));
@@ -84,17 +85,7 @@ fn tiny_demo_evaluate_and_sweep() {
     assert_eq!(auth.lines().count(), 1 + 8 * 7, "D_x 8 states × 7 inputs");
 
     // A rerun with the same configuration skips every stage.
-    ok(&[
-        "demo",
-        "--out",
-        d,
-        "--trajectories",
-        "8",
-        "--epochs",
-        "3",
-        "--seed",
-        "5",
-    ]);
+    ok(&run);
     let s2 = json(&dir.join("summary.json"));
     assert!(
         s2["timings"]

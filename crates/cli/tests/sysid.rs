@@ -173,28 +173,7 @@ fn split_with_too_few_training_samples_is_rejected() {
 fn short_run_on_actuator_beats_the_mean_predictor() {
     let dir = tempfile::tempdir().unwrap();
     let fig = dir.path().join("actuator.svg");
-    let mat = sysid_file("actuator.mat");
-    let out = flapssm(&[
-        "sysid",
-        mat.to_str().unwrap(),
-        "--input",
-        "u",
-        "--output",
-        "p",
-        "--seeds",
-        "1",
-        "--iterations",
-        "150",
-        "--json",
-        "--plot",
-        fig.to_str().unwrap(),
-    ]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let r: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let r = actuator_run("150", &["--plot", fig.to_str().unwrap()]);
     assert_eq!(r["n_train"], 512);
     assert_eq!(r["n_test"], 512);
     // Published sanity value of the data README: predicting the training mean gives 1.630.
@@ -210,8 +189,8 @@ fn short_run_on_actuator_beats_the_mean_predictor() {
     assert!(svg.starts_with("<svg") && svg.contains("test sample"));
 }
 
-/// Short actuator run with the given extra arguments; the parsed JSON report.
-fn short_actuator_run(extra: &[&str]) -> serde_json::Value {
+/// One-seed actuator run of `iterations` with the given extra arguments; the parsed JSON report.
+fn actuator_run(iterations: &str, extra: &[&str]) -> serde_json::Value {
     let mat = sysid_file("actuator.mat");
     let mut args = vec![
         "sysid",
@@ -223,7 +202,7 @@ fn short_actuator_run(extra: &[&str]) -> serde_json::Value {
         "--seeds",
         "1",
         "--iterations",
-        "100",
+        iterations,
         "--json",
     ];
     args.extend_from_slice(extra);
@@ -234,6 +213,11 @@ fn short_actuator_run(extra: &[&str]) -> serde_json::Value {
         String::from_utf8_lossy(&out.stderr)
     );
     serde_json::from_slice(&out.stdout).unwrap()
+}
+
+/// Short (100-iteration) actuator run with the given extra arguments.
+fn short_actuator_run(extra: &[&str]) -> serde_json::Value {
+    actuator_run("100", extra)
 }
 
 #[test]
