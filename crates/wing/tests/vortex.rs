@@ -861,3 +861,31 @@ fn study_wing_hover_trace() {
         println!("cycle {cyc}: max |C_Fx| {m:.2}");
     }
 }
+
+/// Regression (round 5): after a reversal the plate moves back over its last TEV. Placing the
+/// new TEV 1/3 of the way towards it put it on the plate (1 − kb → 0), and the Kelvin solve
+/// shed runaway TEV/LEV pairs (|Γ| ~ 10³ m²/s by cycle 4 at r_cp). With the 1/3 rule used only
+/// while the last TEV lies behind the TE, the circulations stay physical over 6 cycles.
+#[test]
+fn strip_hover_circulation_stays_bounded() {
+    let (states, dt) = hover_states(F_HOVER, 6);
+    let geom = SectionGeometry {
+        chord_m: 0.06,
+        pitch_axis_frac: 0.15,
+        radius_m: 0.178,
+        density_kg_m3: 800.0,
+    };
+    let mut strip = StripLdvm::new(StripLdvmParams::default(), &geom);
+    let mut max_gamma = 0.0f64;
+    for (i, s) in states.iter().enumerate() {
+        let loads = strip.step(&section_kin(s, 0.178), if i == 0 { 0.0 } else { dt });
+        assert!(loads.normal_n_m.is_finite(), "sample {i}");
+        let wake = strip.ldvm().expect("valid strip").wake();
+        max_gamma = wake
+            .gamma_m2_s()
+            .iter()
+            .fold(max_gamma, |m, g| m.max(g.abs()));
+    }
+    println!("strip hover, 6 cycles: max |Γ| {max_gamma:.3} m²/s");
+    assert!(max_gamma < 0.5, "max |Γ| = {max_gamma} m²/s");
+}

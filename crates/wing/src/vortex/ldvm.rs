@@ -256,18 +256,25 @@ impl Ldvm {
         let (b0b, b1b) = (self.coef(0, Field::Base), self.coef(1, Field::Base));
         let s_free = self.wake.total_circulation();
 
-        // new TEV: 1/3 of the way from the TE to the previous TEV (first: half a step downstream)
+        // new TEV: 1/3 of the way from the TE to the previous TEV while that one lies behind the
+        // TE; otherwise (first TEV, or after a reversal has carried the plate over its wake) half a
+        // step downstream. Placed towards a TEV over the plate, the new one would sit on the plate
+        // (1 − kb → 0) and the Kelvin solve would shed a runaway TEV.
         let te = [le[0] + c * tx, le[1] + c * tz];
         let v_te = [
             vx - omega * (c - self.xp) * tz,
             vz + omega * (c - self.xp) * tx,
         ];
+        let behind_te = |i: usize| {
+            let (x, z) = self.wake.pos(i);
+            (x - le[0]) * tx + (z - le[1]) * tz > c
+        };
         let p_tev = match self.wake.last_tev {
-            Some(i) => {
+            Some(i) if behind_te(i) => {
                 let (x, z) = self.wake.pos(i);
                 [te[0] + (x - te[0]) / 3.0, te[1] + (z - te[1]) / 3.0]
             }
-            None => first_position(te, v_te, [tx, tz], dt_s, c),
+            _ => first_position(te, v_te, [tx, tz], dt_s, c),
         };
         self.unit_influence(p_tev, le, [tx, tz], [nx, nz], true);
         let (b0t, b1t) = (self.coef(0, Field::Tev), self.coef(1, Field::Tev));
