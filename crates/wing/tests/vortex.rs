@@ -780,6 +780,19 @@ fn wing_l2_hovering_sanity() {
     );
 }
 
+/// Radius of the centre of pressure of the hover tests' wing, ∫r³dr / ∫r²dr over 0.055–0.235 m (m).
+const R_CP_M: f64 = 0.178;
+
+/// The strip of the hover tests' wing at r_cp.
+fn rcp_section() -> SectionGeometry {
+    SectionGeometry {
+        chord_m: 0.06,
+        pitch_axis_frac: 0.15,
+        radius_m: R_CP_M,
+        density_kg_m3: 800.0,
+    }
+}
+
 /// Section kinematics of the strip at radius `r` (as the blade-element integrator forms them).
 fn section_kin(s: &EulerState, r: f64) -> SectionKinematics {
     let k = WingKinematics::from_euler(s);
@@ -800,12 +813,7 @@ fn section_kin(s: &EulerState, r: f64) -> SectionKinematics {
 /// Returns (full − QS, deleted − QS, QS) means (N/m, sign of the translational force).
 fn wake_capture_measure() -> (f64, f64, f64) {
     let (states, dt) = hover_states(F_HOVER, 4);
-    let geom = SectionGeometry {
-        chord_m: 0.06,
-        pitch_axis_frac: 0.15,
-        radius_m: 0.178,
-        density_kg_m3: 800.0,
-    };
+    let geom = rcp_section();
     let qs = QuasiSteadySection::new(geom, QuasiSteadyParams::default());
     let mut full = StripLdvm::new(StripLdvmParams::default(), &geom);
     let mut cut = StripLdvm::new(StripLdvmParams::default(), &geom);
@@ -814,7 +822,7 @@ fn wake_capture_measure() -> (f64, f64, f64) {
     let window = (0.15 * half as f64) as usize;
     let (mut d_full, mut d_cut, mut q_sum, mut m) = (0.0, 0.0, 0.0, 0);
     for (i, s) in states.iter().enumerate() {
-        let kin = section_kin(s, 0.178);
+        let kin = section_kin(s, R_CP_M);
         let dti = if i == 0 { 0.0 } else { dt };
         let rel = (i + PER_CYCLE / 4) % half; // samples since the last reversal
         if rel == 0 && i > 0 {
@@ -869,16 +877,11 @@ fn study_wing_hover_trace() {
 #[test]
 fn strip_hover_circulation_stays_bounded() {
     let (states, dt) = hover_states(F_HOVER, 6);
-    let geom = SectionGeometry {
-        chord_m: 0.06,
-        pitch_axis_frac: 0.15,
-        radius_m: 0.178,
-        density_kg_m3: 800.0,
-    };
+    let geom = rcp_section();
     let mut strip = StripLdvm::new(StripLdvmParams::default(), &geom);
     let mut max_gamma = 0.0f64;
     for (i, s) in states.iter().enumerate() {
-        let loads = strip.step(&section_kin(s, 0.178), if i == 0 { 0.0 } else { dt });
+        let loads = strip.step(&section_kin(s, R_CP_M), if i == 0 { 0.0 } else { dt });
         assert!(loads.normal_n_m.is_finite(), "sample {i}");
         let wake = strip.ldvm().expect("valid strip").wake();
         max_gamma = wake

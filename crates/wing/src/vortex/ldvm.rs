@@ -265,13 +265,8 @@ impl Ldvm {
             vx - omega * (c - self.xp) * tz,
             vz + omega * (c - self.xp) * tx,
         ];
-        let behind_te = |i: usize| {
-            let (x, z) = self.wake.pos(i);
-            (x - le[0]) * tx + (z - le[1]) * tz > c
-        };
-        let p_tev = match self.wake.last_tev {
-            Some(i) if behind_te(i) => {
-                let (x, z) = self.wake.pos(i);
+        let p_tev = match self.wake.last_tev.map(|i| self.wake.pos(i)) {
+            Some((x, z)) if (x - le[0]) * tx + (z - le[1]) * tz > c => {
                 [te[0] + (x - te[0]) / 3.0, te[1] + (z - te[1]) / 3.0]
             }
             _ => first_position(te, v_te, [tx, tz], dt_s, c),
