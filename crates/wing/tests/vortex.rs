@@ -723,10 +723,9 @@ fn wing_l2_zero_motion_gives_zero_load() {
 }
 
 /// Doubling the flapping frequency (same samples per cycle) multiplies every load by 4: the
-/// coefficients agree to < 1 % of each channel's peak. Fails today: the vortex–plate
-/// encounters after reversal make the hover chaotic (docs/vortex-method.md, Known gaps).
+/// coefficients agree to < 1 % of each channel's peak (measured: bit for bit, as every length
+/// and time in the solver scales with the motion, the first step included).
 #[test]
-#[ignore = "open gap: L2 hover not yet stable (docs/vortex-method.md)"]
 fn wing_l2_time_scaling() {
     let (slow, dt) = hover_states(F_HOVER, 2);
     let (fast, dt2) = hover_states(2.0 * F_HOVER, 2);
@@ -740,44 +739,63 @@ fn wing_l2_time_scaling() {
     }
 }
 
-/// Robofly-like hover at L2 (2 Gauss strips, last of 4 cycles): cycle-mean C_L (Robofly
-/// convention, Sane & Dickinson 2001) in [1.0, 1.8]; C_F (½ρSU_ref²) in [−4, 7] and C_M
-/// (½ρc̄SU_ref²) in [−11, 13] at every sample, as in the dataset's plots (physics notes §4.4.9).
-/// Fails today (docs/vortex-method.md, Known gaps).
-#[test]
-#[ignore = "open gap: L2 hover not yet stable (docs/vortex-method.md)"]
-fn wing_l2_hovering_sanity() {
+/// Robofly-like hover at L2 (2 Gauss strips, 4 cycles): per-cycle mean C_L (Robofly convention,
+/// Sane & Dickinson 2001), and C_F (½ρSU_ref²) and C_M (½ρc̄SU_ref²) over cycles 2–4 (after the
+/// impulsive start).
+fn l2_hover_coefficients() -> (Vec<f64>, (f64, f64), (f64, f64)) {
     let cycles = 4;
     let (states, dt) = hover_states(F_HOVER, cycles);
     let y = run_blade(&states, dt, 2);
-    let n = states.len();
     let amp = 80f64.to_radians();
     let u_ref = 0.235 * 4.0 * amp * F_HOVER;
     let q_s = 0.5 * 800.0 * 0.0108 * u_ref * u_ref;
     let i2 = (0.235f64.powi(3) - 0.055f64.powi(3)) / 3.0;
-    let (mut lift, mut phi_dot2) = (0.0, 0.0);
+    let mut cl = Vec::new();
     let (mut cf_rng, mut cm_rng) = ((f64::MAX, f64::MIN), (f64::MAX, f64::MIN));
-    for i in n - PER_CYCLE..n {
-        let r = rotation_global_from_wing(&states[i].angles_rad);
-        lift += r[1][0] * y[i][0] + r[1][1] * y[i][1];
-        phi_dot2 += states[i].rates_rad_s[0].powi(2);
-        for v in [y[i][0] / q_s, y[i][1] / q_s] {
-            cf_rng = (cf_rng.0.min(v), cf_rng.1.max(v));
+    for cyc in 0..cycles {
+        let (mut lift, mut phi_dot2) = (0.0, 0.0);
+        for i in cyc * PER_CYCLE..(cyc + 1) * PER_CYCLE {
+            let r = rotation_global_from_wing(&states[i].angles_rad);
+            lift += r[1][0] * y[i][0] + r[1][1] * y[i][1];
+            phi_dot2 += states[i].rates_rad_s[0].powi(2);
+            if cyc == 0 {
+                continue;
+            }
+            for v in [y[i][0] / q_s, y[i][1] / q_s] {
+                cf_rng = (cf_rng.0.min(v), cf_rng.1.max(v));
+            }
+            for m in &y[i][2..5] {
+                let v = m / (1e3 * q_s * 0.06);
+                cm_rng = (cm_rng.0.min(v), cm_rng.1.max(v));
+            }
         }
-        for m in &y[i][2..5] {
-            let v = m / (1e3 * q_s * 0.06);
-            cm_rng = (cm_rng.0.min(v), cm_rng.1.max(v));
-        }
+        cl.push(lift / (0.5 * 800.0 * 0.06 * i2 * phi_dot2));
     }
-    let q_robofly = 0.5 * 800.0 * 0.06 * i2 * phi_dot2 / PER_CYCLE as f64;
-    let cl = lift / PER_CYCLE as f64 / q_robofly;
-    println!("L2 hover: mean C_L {cl:.3}, C_F range {cf_rng:.2?}, C_M range {cm_rng:.2?}");
-    assert!((1.0..=1.8).contains(&cl), "cycle-mean C_L = {cl}");
-    assert!(cf_rng.0 >= -4.0 && cf_rng.1 <= 7.0, "C_F range {cf_rng:?}");
-    assert!(
-        cm_rng.0 >= -11.0 && cm_rng.1 <= 13.0,
-        "C_M range {cm_rng:?}"
+    println!(
+        "L2 hover: per-cycle mean C_L {cl:.3?}, C_F range {cf_rng:.2?}, C_M range {cm_rng:.2?}"
     );
+    (cl, cf_rng, cm_rng)
+}
+
+/// The L2 hover stays inside the dataset's plotted ranges at every sample of cycles 2–4:
+/// C_F ∈ [−4, 7], C_M ∈ [−11, 13] (physics notes §4.4.9).
+#[test]
+fn wing_l2_hover_stays_in_the_dataset_ranges() {
+    let (_, cf, cm) = l2_hover_coefficients();
+    assert!(cf.0 >= -4.0 && cf.1 <= 7.0, "C_F range {cf:?}");
+    assert!(cm.0 >= -11.0 && cm.1 <= 13.0, "C_M range {cm:?}");
+}
+
+/// Cycle-mean C_L of the L2 hover in [1.0, 1.8] for cycles 2–4 (physics notes §4.4.9). Fails
+/// narrowly: 1.76 / 1.95 / 1.81 (1.69–2.48, mean 1.93, over cycles 2–10), against 1.75 at L0
+/// (docs/vortex-method.md, Known gaps).
+#[test]
+#[ignore = "open gap: L2 hover mean C_L ≈ 1.9, above the 1.8 bound (docs/vortex-method.md)"]
+fn wing_l2_hover_mean_lift_in_band() {
+    let (cl, _, _) = l2_hover_coefficients();
+    for (i, c) in cl.iter().enumerate().skip(1) {
+        assert!((1.0..=1.8).contains(c), "cycle {}: mean C_L = {c}", i + 1);
+    }
 }
 
 /// Radius of the centre of pressure of the hover tests' wing, ∫r³dr / ∫r²dr over 0.055–0.235 m (m).
@@ -870,25 +888,36 @@ fn study_wing_hover_trace() {
     }
 }
 
-/// Regression (round 5): after a reversal the plate moves back over its last TEV. Placing the
-/// new TEV 1/3 of the way towards it put it on the plate (1 − kb → 0), and the Kelvin solve
-/// shed runaway TEV/LEV pairs (|Γ| ~ 10³ m²/s by cycle 4 at r_cp). With the 1/3 rule used only
-/// while the last TEV lies behind the TE, the circulations stay physical over 6 cycles.
+/// Regressions of the r_cp strip over 6 hover cycles.
+/// - Round 5: after a reversal the plate moves back over its last TEV. Placing the new TEV 1/3
+///   of the way towards it put it on the plate (1 − kb → 0), and the Kelvin solve shed runaway
+///   TEV/LEV pairs (|Γ| ~ 10³ m²/s by cycle 4). With the 1/3 rule used only while the last TEV
+///   lies behind the TE, the circulations stay physical.
+/// - Round 6: a vortex deleted in the far field (or to make room) took its circulation out of
+///   Kelvin's balance, so the next step shed a TEV/LEV pair 30× the usual size at the plate:
+///   single-sample spikes of |N'| up to 1441 N/m. Removed vortices now keep their circulation
+///   at infinity, and a sample's load is the mean over its sub-steps: |N'| stays below 2× the
+///   physical peak (≈ 30 N/m) after the first cycle.
 #[test]
 fn strip_hover_circulation_stays_bounded() {
     let (states, dt) = hover_states(F_HOVER, 6);
     let geom = rcp_section();
     let mut strip = StripLdvm::new(StripLdvmParams::default(), &geom);
     let mut max_gamma = 0.0f64;
+    let mut max_normal = 0.0f64;
     for (i, s) in states.iter().enumerate() {
         let loads = strip.step(&section_kin(s, R_CP_M), if i == 0 { 0.0 } else { dt });
         assert!(loads.normal_n_m.is_finite(), "sample {i}");
+        if i >= PER_CYCLE {
+            max_normal = max_normal.max(loads.normal_n_m.abs());
+        }
         let wake = strip.ldvm().expect("valid strip").wake();
         max_gamma = wake
             .gamma_m2_s()
             .iter()
             .fold(max_gamma, |m, g| m.max(g.abs()));
     }
-    println!("strip hover, 6 cycles: max |Γ| {max_gamma:.3} m²/s");
+    println!("strip hover, 6 cycles: max |Γ| {max_gamma:.3} m²/s, max |N'| {max_normal:.1} N/m");
     assert!(max_gamma < 0.5, "max |Γ| = {max_gamma} m²/s");
+    assert!(max_normal < 60.0, "max |N'| = {max_normal} N/m");
 }

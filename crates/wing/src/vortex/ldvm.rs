@@ -188,11 +188,11 @@ impl Ldvm {
         self.diag = LdvmDiagnostics::default();
     }
 
-    /// Deletes every free vortex (wake and LEVs) but keeps the bound sheet and its history: the
-    /// next step sheds the circulation that Kelvin then requires, as if the fluid around the
-    /// plate had been replaced by fluid at rest. For wake-capture experiments.
+    /// Removes every free vortex (wake and LEVs) to infinity but keeps the bound sheet and its
+    /// history: the plate no longer feels their induced velocity, and their circulation stays
+    /// in Kelvin's balance, so nothing is shed to replace them. For wake-capture experiments.
     pub fn clear_wake(&mut self) {
-        self.wake.clear();
+        self.wake.remove_all_to_far();
         self.last_lev_step = None;
     }
 

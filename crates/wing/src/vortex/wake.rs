@@ -49,6 +49,10 @@ pub struct Wake {
     /// Index of the newest TEV / LEV (protected from merging; used to place the next one).
     pub(crate) last_tev: Option<usize>,
     pub(crate) last_lev: Option<usize>,
+    /// Circulation of the vortices removed from the plane (far-field deletion, last-resort
+    /// removal, `clear_wake`) (m²/s): it still counts in Kelvin's theorem, as vortices at
+    /// infinity that induce no velocity, so a deletion does not force the plate to shed.
+    far_circulation: f64,
 }
 
 /// Adds to (u, w) the velocity at (px, pz) induced by vortices (xs, zs, gs).
@@ -87,6 +91,7 @@ impl Wake {
             best: Vec::with_capacity(capacity),
             last_tev: None,
             last_lev: None,
+            far_circulation: 0.0,
         }
     }
 
@@ -100,6 +105,14 @@ impl Wake {
         self.w.clear();
         self.last_tev = None;
         self.last_lev = None;
+        self.far_circulation = 0.0;
+    }
+
+    /// Removes every vortex to infinity: their circulation stays in Kelvin's balance.
+    pub(crate) fn remove_all_to_far(&mut self) {
+        let far = self.total_circulation();
+        self.clear();
+        self.far_circulation = far;
     }
 
     /// Number of free vortices.
@@ -137,9 +150,14 @@ impl Wake {
         &self.kind
     }
 
-    /// Σ Γ of the free vortices (m²/s).
+    /// Σ Γ of the free vortices, including those removed to infinity (m²/s).
     pub fn total_circulation(&self) -> f64 {
-        self.gamma.iter().sum()
+        self.gamma.iter().sum::<f64>() + self.far_circulation
+    }
+
+    /// Circulation of the vortices removed to infinity (m²/s).
+    pub fn far_circulation(&self) -> f64 {
+        self.far_circulation
     }
 
     /// Velocity (m/s) induced at (px, pz) by all free vortices.
@@ -219,20 +237,24 @@ impl Wake {
     /// Multiplies TEV circulations by `f_tev` and LEV circulations by `f_lev`.
     pub(crate) fn decay(&mut self, f_tev: f64, f_lev: f64) {
         for (g, k) in self.gamma.iter_mut().zip(&self.kind) {
-            *g *= match k {
+            let f = match k {
                 VortexKind::Tev => f_tev,
                 VortexKind::Lev => f_lev,
             };
+            *g *= f;
         }
     }
 
-    /// Marks for deletion every vortex farther than sqrt(r2_max) from (px, pz); then compacts.
+    /// Removes to infinity every vortex farther than sqrt(r2_max) from (px, pz); then compacts.
     pub(crate) fn delete_far(&mut self, px: f64, pz: f64, r2_max: f64) {
         self.keep.clear();
         let mut any = false;
         for i in 0..self.len() {
             let d2 = (self.x[i] - px).powi(2) + (self.z[i] - pz).powi(2);
             let k = d2 <= r2_max;
+            if !k {
+                self.far_circulation += self.gamma[i];
+            }
             any |= !k;
             self.keep.push(k);
         }
@@ -335,8 +357,8 @@ impl Wake {
         }
     }
 
-    /// Removes the weakest unprotected vortex (last resort when amalgamation cannot make room;
-    /// loses its circulation).
+    /// Removes the weakest unprotected vortex to infinity (last resort when amalgamation cannot
+    /// make room).
     pub(crate) fn remove_weakest(&mut self) {
         let mut weakest = None;
         for i in 0..self.len() {
@@ -348,6 +370,7 @@ impl Wake {
             }
         }
         let Some(k) = weakest else { return };
+        self.far_circulation += self.gamma[k];
         self.keep.clear();
         self.keep.resize(self.len(), true);
         self.keep[k] = false;
@@ -406,6 +429,32 @@ mod tests {
             assert_eq!(wake.len(), expect, "second vortex at z = {zb}");
             assert!((wake.total_circulation() - 1.0).abs() < 1e-15);
         }
+    }
+
+    /// Vortices deleted in the far field, removed to make room or cleared keep their
+    /// circulation in the Kelvin balance; `clear` (a reset) forgets it.
+    #[test]
+    fn removed_vortices_keep_their_circulation_at_infinity() {
+        let mut wake = Wake::with_capacity(8);
+        wake.push(0.0, 0.0, 0.3, VortexKind::Tev);
+        wake.push(20.0, 0.0, -0.2, VortexKind::Tev);
+        wake.push(0.5, 0.0, 0.05, VortexKind::Lev);
+        wake.push(1.0, 0.0, 0.7, VortexKind::Tev); // newest TEV, protected
+        wake.delete_far(0.0, 0.0, 4.0);
+        assert_eq!(wake.len(), 3);
+        assert!((wake.far_circulation() + 0.2).abs() < 1e-15);
+        wake.remove_weakest(); // the newest LEV and TEV are protected: removes the 0.3
+        assert_eq!(wake.len(), 2);
+        assert!((wake.far_circulation() - 0.1).abs() < 1e-15);
+        assert!((wake.total_circulation() - 0.85).abs() < 1e-15);
+        // removed vortices induce nothing
+        let (u, w) = wake.velocity_at(0.5, 1.0, 1e-8);
+        let (u2, w2) = induced_at(0.5, 1.0, &[0.5, 1.0], &[0.0, 0.0], &[0.05, 0.7], 1e-8);
+        assert_eq!((u, w), (u2, w2));
+        wake.remove_all_to_far();
+        assert!(wake.is_empty() && (wake.total_circulation() - 0.85).abs() < 1e-15);
+        wake.clear();
+        assert_eq!(wake.total_circulation(), 0.0);
     }
 
     #[test]
