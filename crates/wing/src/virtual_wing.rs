@@ -18,6 +18,7 @@ use crate::cycles::{self, CycleError};
 use crate::kinematics::{EulerState, WingKinematics, rotation_global_from_wing};
 use crate::sensor::{DatasetSensorErrors, SensorConfig, measure};
 use crate::trajectories::{GeneratorConfig, TrajectoryError, TrajectorySpec};
+use crate::vortex::{LdvmParams, StripLdvmFactory, StripLdvmParams, VortexError};
 use flapssm_data::dataset::{
     DatasetMeta, FORMAT_VERSION, Fluid, INPUT_UNITS, OUTPUT_UNITS, WingGeometry,
 };
@@ -67,14 +68,9 @@ pub enum SimulateError {
         /// The name given.
         name: String,
     },
-    /// The fidelity is not dispatched (its model does not yet meet its validation).
-    #[error("fidelity {fidelity:?} is not available: {reason}")]
-    FidelityUnavailable {
-        /// The fidelity asked for.
-        fidelity: Fidelity,
-        /// Why.
-        reason: &'static str,
-    },
+    /// The L2 (LDVM) settings are invalid.
+    #[error("invalid L2 setting: {0}")]
+    InvalidL2(VortexError),
     /// A configuration value is out of range.
     #[error("invalid simulator setting `{field}` = {value}: {reason}")]
     InvalidConfig {
@@ -133,6 +129,11 @@ pub struct VirtualWingConfig {
     pub n_strips: usize,
     /// L0/L1 parameters (L0 uses only `aero.quasi_steady`).
     pub aero: UnsteadyParams,
+    /// L2 parameters (strip LDVM, docs/vortex-method.md).
+    pub l2: StripLdvmParams,
+    /// Blade-element strips at L2 (Gauss–Legendre; 2, exact for ∫r² and ∫r³; each strip is a
+    /// vortex simulation, so `n_strips` applies to L0/L1 only).
+    pub l2_strips: usize,
     /// Sensor and post-processing.
     pub sensor: SensorConfig,
 }
@@ -147,6 +148,8 @@ impl Default for VirtualWingConfig {
             fluid: Fluid::default(),
             n_strips: 8,
             aero: UnsteadyParams::default(),
+            l2: StripLdvmParams::default(),
+            l2_strips: 2,
             sensor: SensorConfig::default(),
         }
     }
@@ -193,12 +196,45 @@ impl VirtualWingConfig {
                 });
             }
         }
-        if self.n_strips == 0 || self.n_strips > 200 {
-            return Err(SimulateError::InvalidConfig {
-                field: "n_strips",
-                value: self.n_strips as f64,
-                reason: "must be in 1..=200",
-            });
+        for (field, n) in [("n_strips", self.n_strips), ("l2_strips", self.l2_strips)] {
+            if n == 0 || n > 200 {
+                return Err(SimulateError::InvalidConfig {
+                    field,
+                    value: n as f64,
+                    reason: "must be in 1..=200",
+                });
+            }
+        }
+        if self.fidelity == Fidelity::L2 {
+            let l2 = &self.l2;
+            if !(l2.max_step_chords.is_finite() && l2.max_step_chords > 0.0) {
+                return Err(SimulateError::InvalidConfig {
+                    field: "l2.max_step_chords",
+                    value: l2.max_step_chords,
+                    reason: "must be finite and > 0",
+                });
+            }
+            if l2.max_substeps == 0 {
+                return Err(SimulateError::InvalidConfig {
+                    field: "l2.max_substeps",
+                    value: 0.0,
+                    reason: "must be ≥ 1",
+                });
+            }
+            if !(l2.cn_3d_factor.is_finite() && l2.cn_3d_factor > 0.0) {
+                return Err(SimulateError::InvalidConfig {
+                    field: "l2.cn_3d_factor",
+                    value: l2.cn_3d_factor,
+                    reason: "must be finite and > 0",
+                });
+            }
+            let section = LdvmParams {
+                chord_m: self.wing.chord_m,
+                pivot_frac: self.wing.pitch_axis_frac,
+                rho_kg_m3: self.fluid.density_kg_m3,
+                ..l2.ldvm
+            };
+            section.check().map_err(SimulateError::InvalidL2)?;
         }
         Ok(())
     }
@@ -208,11 +244,7 @@ impl VirtualWingConfig {
         match self.fidelity {
             Fidelity::L0 => Ok(Box::new(self.aero.quasi_steady)),
             Fidelity::L1 => Ok(Box::new(self.aero)),
-            Fidelity::L2 => Err(SimulateError::FidelityUnavailable {
-                fidelity: Fidelity::L2,
-                reason: "the strip vortex model (vortex::StripLdvmFactory) is not yet stable over repeated \
-                         stroke reversals (docs/vortex-method.md, Known gaps)",
-            }),
+            Fidelity::L2 => Ok(Box::new(StripLdvmFactory { params: self.l2 })),
         }
     }
 }
@@ -238,7 +270,11 @@ impl VirtualWing {
     pub fn new(cfg: &VirtualWingConfig) -> Result<Self, SimulateError> {
         cfg.check()?;
         let factory = cfg.factory()?;
-        let blade = BladeElement::new(cfg.blade_geometry(), cfg.n_strips, factory.as_ref())?;
+        let strips = match cfg.fidelity {
+            Fidelity::L2 => cfg.l2_strips,
+            Fidelity::L0 | Fidelity::L1 => cfg.n_strips,
+        };
+        let blade = BladeElement::new(cfg.blade_geometry(), strips, factory.as_ref())?;
         Ok(Self {
             cfg: cfg.clone(),
             blade,
@@ -417,14 +453,10 @@ pub fn simulate_dataset(
     let errors = DatasetSensorErrors::draw(&cfg.wing.sensor, &mut dataset_rng);
     let run_one = |wing: &mut Result<VirtualWing, SimulateError>,
                    (index, spec): (usize, &TrajectorySpec)| {
-        let wing = wing.as_mut().map_err(|e| SimulateError::InvalidConfig {
+        let wing = wing.as_mut().map_err(|_| SimulateError::InvalidConfig {
             field: "wing",
             value: f64::NAN,
-            reason: if matches!(e, SimulateError::FidelityUnavailable { .. }) {
-                "fidelity unavailable"
-            } else {
-                "invalid"
-            },
+            reason: "invalid",
         })?;
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
         rng.set_stream(index as u64);
