@@ -11,14 +11,14 @@
 //! when `sensor.encoder` is off). Trajectories run in parallel (feature `parallel`); trajectory i uses
 //! ChaCha8 stream i of the seed, so results do not depend on threading.
 
-use crate::aero::SectionModelFactory;
 use crate::aero::blade_element::{AeroError, BladeElement, BladeGeometry};
 use crate::aero::unsteady::UnsteadyParams;
+use crate::aero::{SectionGeometry, SectionModelFactory};
 use crate::cycles::{self, CycleError};
 use crate::kinematics::{EulerState, WingKinematics, rotation_global_from_wing};
 use crate::sensor::{DatasetSensorErrors, SensorConfig, measure};
 use crate::trajectories::{GeneratorConfig, TrajectoryError, TrajectorySpec};
-use crate::vortex::{LdvmParams, StripLdvmFactory, StripLdvmParams, VortexError};
+use crate::vortex::{StripLdvmFactory, StripLdvmParams, VortexError};
 use flapssm_data::dataset::{
     DatasetMeta, FORMAT_VERSION, Fluid, INPUT_UNITS, OUTPUT_UNITS, WingGeometry,
 };
@@ -206,35 +206,13 @@ impl VirtualWingConfig {
             }
         }
         if self.fidelity == Fidelity::L2 {
-            let l2 = &self.l2;
-            if !(l2.max_step_chords.is_finite() && l2.max_step_chords > 0.0) {
-                return Err(SimulateError::InvalidConfig {
-                    field: "l2.max_step_chords",
-                    value: l2.max_step_chords,
-                    reason: "must be finite and > 0",
-                });
-            }
-            if l2.max_substeps == 0 {
-                return Err(SimulateError::InvalidConfig {
-                    field: "l2.max_substeps",
-                    value: 0.0,
-                    reason: "must be ≥ 1",
-                });
-            }
-            if !(l2.cn_3d_factor.is_finite() && l2.cn_3d_factor > 0.0) {
-                return Err(SimulateError::InvalidConfig {
-                    field: "l2.cn_3d_factor",
-                    value: l2.cn_3d_factor,
-                    reason: "must be finite and > 0",
-                });
-            }
-            let section = LdvmParams {
+            let section = SectionGeometry {
                 chord_m: self.wing.chord_m,
-                pivot_frac: self.wing.pitch_axis_frac,
-                rho_kg_m3: self.fluid.density_kg_m3,
-                ..l2.ldvm
+                pitch_axis_frac: self.wing.pitch_axis_frac,
+                radius_m: self.wing.u_ref_radius_m,
+                density_kg_m3: self.fluid.density_kg_m3,
             };
-            section.check().map_err(SimulateError::InvalidL2)?;
+            self.l2.check(&section).map_err(SimulateError::InvalidL2)?;
         }
         Ok(())
     }

@@ -529,3 +529,24 @@ fn l2_dataset_is_finite_and_sized_like_l0() {
     assert!((0.6..=1.6).contains(&slope), "slope {slope}");
     assert!(corr > 0.6, "correlation {corr}");
 }
+
+/// A bad L2 setting is refused before anything runs, and the message names the field.
+#[test]
+fn invalid_l2_settings_are_refused_by_name() {
+    let mut cfg = VirtualWingConfig {
+        fidelity: Fidelity::L2,
+        ..Default::default()
+    };
+    cfg.l2.max_step_chords = 0.0;
+    let e = cfg.check().unwrap_err().to_string();
+    assert!(e.contains("max_step_chords"), "{e}");
+    cfg.l2.max_step_chords = 0.0125;
+    cfg.l2.ldvm.core_radius_frac = f64::NAN;
+    let e = VirtualWing::new(&cfg)
+        .err()
+        .expect("NaN core radius")
+        .to_string();
+    assert!(e.contains("core_radius_frac"), "{e}");
+    cfg.l2.ldvm.core_radius_frac = 0.02;
+    assert!(cfg.check().is_ok());
+}

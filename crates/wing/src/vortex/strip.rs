@@ -43,7 +43,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::{Ldvm, LdvmParams, PlateState};
+use super::{Ldvm, LdvmParams, PlateState, VortexError};
 use crate::aero::{
     SectionGeometry, SectionKinematics, SectionLoads, SectionModel, SectionModelFactory,
 };
@@ -61,6 +61,48 @@ pub struct StripLdvmParams {
     pub max_step_chords: f64,
     /// Cap on the sub-steps per sample interval (default 8).
     pub max_substeps: usize,
+}
+
+impl StripLdvmParams {
+    /// The LDVM settings of one strip: the template with the section's chord, pivot and density.
+    pub fn section_params(&self, section: &SectionGeometry) -> LdvmParams {
+        LdvmParams {
+            chord_m: section.chord_m,
+            pivot_frac: section.pitch_axis_frac,
+            rho_kg_m3: section.density_kg_m3,
+            ..self.ldvm
+        }
+    }
+
+    /// Checks every field for the strip `section`; returns the first violation.
+    pub fn check(&self, section: &SectionGeometry) -> Result<(), VortexError> {
+        let positive = [
+            ("max_step_chords", self.max_step_chords),
+            ("cn_3d_factor", self.cn_3d_factor),
+        ];
+        for (name, value) in positive {
+            if !(value.is_finite() && value > 0.0) {
+                return Err(VortexError::InvalidParameter {
+                    name,
+                    value,
+                    reason: "must be finite and > 0",
+                });
+            }
+        }
+        if self.max_substeps == 0 {
+            return Err(VortexError::InvalidParameter {
+                name: "max_substeps",
+                value: 0.0,
+                reason: "must be >= 1",
+            });
+        }
+        self.section_params(section).check()
+    }
+}
+
+/// Largest distance from the pivot to an edge, max(x_p, c − x_p) (m).
+fn pivot_to_edge_m(p: &LdvmParams) -> f64 {
+    p.pivot_frac.max(1.0 - p.pivot_frac) * p.chord_m
 }
 
 impl Default for StripLdvmParams {
@@ -103,20 +145,14 @@ pub struct StripLdvm {
 }
 
 impl StripLdvm {
-    /// Builds the strip. Invalid settings (see [`LdvmParams::check`]) give a model whose loads
-    /// are NaN, so that the output pipeline's finiteness check reports them.
+    /// Builds the strip. Invalid settings (see [`StripLdvmParams::check`]) give a model whose
+    /// loads are NaN, so that the output pipeline's finiteness check reports them.
     pub fn new(params: StripLdvmParams, section: &SectionGeometry) -> Self {
-        let p = LdvmParams {
-            chord_m: section.chord_m,
-            pivot_frac: section.pitch_axis_frac,
-            rho_kg_m3: section.density_kg_m3,
-            ..params.ldvm
-        };
-        let valid = params.max_step_chords.is_finite()
-            && params.max_step_chords > 0.0
-            && params.max_substeps >= 1;
+        let valid = params.check(section).is_ok();
         Self {
-            ldvm: Ldvm::new(p).ok().filter(|_| valid),
+            ldvm: Ldvm::new(params.section_params(section))
+                .ok()
+                .filter(|_| valid),
             cn_3d_factor: params.cn_3d_factor,
             max_step_m: params.max_step_chords * section.chord_m,
             max_substeps: params.max_substeps,
@@ -174,8 +210,7 @@ impl SectionModel for StripLdvm {
             return self.substep(kin, dt_s).unwrap_or(nan);
         }
         let p = ldvm.params();
-        let (c, xp) = (p.chord_m, p.pivot_frac * p.chord_m);
-        let edge = xp.max(c - xp);
+        let edge = pivot_to_edge_m(p);
         let u_max = [
             kin.speed_m_s(),
             self.prev_kin.speed_m_s(),
@@ -231,9 +266,7 @@ impl StripLdvm {
         let dt = if self.started || (dt_s.is_finite() && dt_s > 0.0) {
             dt_s
         } else {
-            let p = ldvm.params();
-            let edge = p.pivot_frac.max(1.0 - p.pivot_frac) * p.chord_m;
-            let u = speed.max(omega.abs() * edge);
+            let u = speed.max(omega.abs() * pivot_to_edge_m(ldvm.params()));
             if u > 0.0 { self.max_step_m / u } else { 1e-3 }
         };
         if self.started {

@@ -237,11 +237,10 @@ impl Wake {
     /// Multiplies TEV circulations by `f_tev` and LEV circulations by `f_lev`.
     pub(crate) fn decay(&mut self, f_tev: f64, f_lev: f64) {
         for (g, k) in self.gamma.iter_mut().zip(&self.kind) {
-            let f = match k {
+            *g *= match k {
                 VortexKind::Tev => f_tev,
                 VortexKind::Lev => f_lev,
             };
-            *g *= f;
         }
     }
 
