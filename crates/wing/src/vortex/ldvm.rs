@@ -58,6 +58,8 @@ pub struct LdvmDiagnostics {
 #[derive(Debug, Clone)]
 pub struct Ldvm {
     p: LdvmParams,
+    /// The current U_ref (m/s): `p.u_ref_m_s` until [`Ldvm::set_reference_speed`] changes it.
+    u_ref_m_s: f64,
     c: f64,
     xp: f64,
     rc4: f64,
@@ -88,6 +90,10 @@ pub struct Ldvm {
     prev_frame: PlateFrame,
     diag: LdvmDiagnostics,
 }
+
+/// Lamb–Oseen vortex: the radius of peak swirl velocity is r_c = 2.2418·√(νt), so
+/// r_c² grows by 5.0257·ν per second.
+const LAMB_OSEEN_CORE: f64 = 5.0257;
 
 /// Coefficients of the unsteady normal force: N'_unsteady = ρπc² Σ NF_n Ḃ_n.
 const NF: [f64; 3] = [0.75, 0.25, 0.125];
@@ -159,19 +165,25 @@ impl Ldvm {
             bx: vec![0.0; nc],
             bz: vec![0.0; nc],
             bg_ccw: vec![0.0; nc],
-            wake: Wake::with_capacity(params.max_vortices),
+            wake: Wake::with_capacity(params.max_vortices, rc),
             step: 0,
             last_lev_step: None,
             prev_speed_m_s: 0.0,
             prev_frame: PlateFrame::default(),
             diag: LdvmDiagnostics::default(),
+            u_ref_m_s: params.u_ref_m_s,
             p: params,
         })
     }
 
-    /// The validated parameters.
+    /// The validated parameters (`u_ref_m_s` as constructed; see [`Ldvm::reference_speed`]).
     pub fn params(&self) -> &LdvmParams {
         &self.p
+    }
+
+    /// The U_ref (m/s) in use: the constructed one until [`Ldvm::set_reference_speed`].
+    pub fn reference_speed(&self) -> f64 {
+        self.u_ref_m_s
     }
 
     /// Back to the state before the first step (fluid at rest, no vortices).
@@ -185,6 +197,8 @@ impl Ldvm {
         self.step = 0;
         self.last_lev_step = None;
         self.prev_speed_m_s = 0.0;
+        self.prev_frame = PlateFrame::default();
+        self.u_ref_m_s = self.p.u_ref_m_s;
         self.diag = LdvmDiagnostics::default();
     }
 
@@ -200,7 +214,7 @@ impl Ldvm {
     /// amalgamation from the next step on.
     pub fn set_reference_speed(&mut self, u_ref_m_s: f64) {
         if u_ref_m_s.is_finite() && u_ref_m_s > 0.0 {
-            self.p.u_ref_m_s = u_ref_m_s;
+            self.u_ref_m_s = u_ref_m_s;
         }
     }
 
@@ -245,10 +259,14 @@ impl Ldvm {
 
         // downwash of everything but the bound sheet and the new vortices
         for j in 0..self.xc.len() {
-            let (px, pz) = (le[0] + self.xc[j] * tx, le[1] + self.xc[j] * tz);
-            self.bx[j] = px;
-            self.bz[j] = pz;
-            let (u, w) = self.wake.velocity_at(px, pz, self.rc4);
+            self.bx[j] = le[0] + self.xc[j] * tx;
+            self.bz[j] = le[1] + self.xc[j] * tz;
+        }
+        // (wn, ut) first hold the wake's (u, w)
+        self.wake
+            .velocities_at(&self.bx, &self.bz, &mut self.wn, &mut self.ut);
+        for j in 0..self.xc.len() {
+            let (u, w) = (self.wn[j], self.ut[j]);
             self.wn[j] = u * nx + w * nz - vpn - omega * (self.xc[j] - self.xp);
             self.ut[j] = u * tx + w * tz;
         }
@@ -284,11 +302,16 @@ impl Ldvm {
         let mut g_tev = rhs_k / a_t;
         let mut g_lev = 0.0;
         let mut p_lev = [0.0; 2];
-        let lesp0 = (b0b + g_tev * b0t) / self.p.u_ref_m_s;
+        let lesp0 = (b0b + g_tev * b0t) / self.u_ref_m_s;
         if let Some(crit) = self.p.lesp_crit.filter(|&cr| lesp0.abs() > cr) {
             let v_le = [vx + omega * self.xp * tz, vz - omega * self.xp * tx];
+            // continue the feeding sheet (1/3 of the way to the LEV shed the step before) only
+            // while the LE keeps shedding the same sign (Γ_LEV = −sign(LESP)); after a sign
+            // flip that LEV sits on the other side, and a new one placed towards it would have
+            // the wrong side and sign: the 2×2 solve then sheds runaway pairs
+            let continues = |i: usize| self.wake.gamma_m2_s()[i] * lesp0 < 0.0;
             p_lev = match (self.wake.last_lev, self.last_lev_step) {
-                (Some(i), Some(st)) if st + 1 == self.step => {
+                (Some(i), Some(st)) if st + 1 == self.step && continues(i) => {
                     let (x, z) = self.wake.pos(i);
                     [le[0] + (x - le[0]) / 3.0, le[1] + (z - le[1]) / 3.0]
                 }
@@ -311,7 +334,7 @@ impl Ldvm {
                     det,
                 });
             }
-            let r0 = lesp0.signum() * crit * self.p.u_ref_m_s - b0b;
+            let r0 = lesp0.signum() * crit * self.u_ref_m_s - b0b;
             g_tev = (r0 * a_l - b0l * rhs_k) / det;
             g_lev = (b0t * rhs_k - a_t * r0) / det;
         }
@@ -393,9 +416,9 @@ impl Ldvm {
             b: &self.b,
         };
         self.wake
-            .compute_velocities(self.rc4, |x, z| sheet.velocity_at(x, z));
+            .compute_velocities(|x, z, u, w| sheet.velocities_at(x, z, u, w));
         self.diag = LdvmDiagnostics {
-            lesp: b0 / self.p.u_ref_m_s,
+            lesp: b0 / self.u_ref_m_s,
             lesp_unshed: lesp0,
             fourier_m_s: [b0, b1, b2, b3],
             bound_circulation_m2_s: -kb(b0, b1),
@@ -465,6 +488,10 @@ impl Ldvm {
         if f_tev != 1.0 || f_lev != 1.0 {
             self.wake.decay(f_tev, f_lev);
         }
+        if let Some(re) = self.p.core_growth_reynolds {
+            self.wake
+                .grow_cores(LAMB_OSEEN_CORE * travel_chords * c * c / re);
+        }
         let [px, pz] = plate.pivot_m;
         if let Some(r) = self.p.far_field_chords {
             self.wake.delete_far(px, pz, (r * c).powi(2));
@@ -480,7 +507,7 @@ impl Ldvm {
             ..
         }) = merge
         {
-            let v0_dim = v0 * self.p.u_ref_m_s / c;
+            let v0_dim = v0 * self.u_ref_m_s / c;
             let (s, co) = plate.angle_rad.sin_cos();
             let le = [px - self.xp * co, pz - self.xp * s];
             let te = [le[0] + c * co, le[1] + c * s];
@@ -544,43 +571,82 @@ pub(crate) struct BoundSheet<'a> {
 impl BoundSheet<'_> {
     /// Velocity (m/s, inertial axes) induced by the sheet at (px, pz).
     pub fn velocity_at(&self, px: f64, pz: f64) -> (f64, f64) {
-        let (dx, dz) = (px - self.le[0], pz - self.le[1]);
-        let x = dx * self.t[0] + dz * self.t[1];
-        let z = dx * self.n[0] + dz * self.n[1];
-        // s = 2(x + iz − c/2)/c; σ = −s ± √(s² − 1), the root outside the unit circle
-        let (sr, si) = (2.0 * x / self.c - 1.0, 2.0 * z / self.c);
-        let (qr, qi) = csqrt(sr * sr - si * si - 1.0, 2.0 * sr * si);
-        let (a, b) = ((-sr + qr, -si + qi), (-sr - qr, -si - qi));
-        let sig = if a.0 * a.0 + a.1 * a.1 >= b.0 * b.0 + b.1 * b.1 {
-            a
-        } else {
-            b
-        };
-        // 1/(σ − 1), regularised
-        let (er, ei) = (sig.0 - 1.0, sig.1);
-        let m2 = er * er + ei * ei;
-        let inv = 1.0 / (m2 * m2 + self.eps4).sqrt();
-        let (ir, ii) = (er * inv, -ei * inv);
-        // F = u − iw = −i[2B0/(σ − 1) + Σ B_n σ^{−n}]
-        let mut fr = 2.0 * self.b[0] * ir;
-        let mut fi = 2.0 * self.b[0] * ii;
-        let d2 = sig.0 * sig.0 + sig.1 * sig.1;
-        let (rr, ri) = (sig.0 / d2, -sig.1 / d2); // 1/σ
-        let (mut pr, mut pi) = (1.0, 0.0);
+        let (u, w) = self.velocity_lanes(&[px], &[pz]);
+        (u[0], w[0])
+    }
+
+    /// Velocities (m/s) at the points (px, pz), written to (u, w): [`BoundSheet::velocity_at`]
+    /// bit for bit, computed for `LANES` points at a time so that it vectorizes.
+    pub fn velocities_at(&self, px: &[f64], pz: &[f64], u: &mut [f64], w: &mut [f64]) {
+        const LANES: usize = 8;
+        let (xc, zc) = (px.chunks_exact(LANES), pz.chunks_exact(LANES));
+        let (uc, wc) = (u.chunks_exact_mut(LANES), w.chunks_exact_mut(LANES));
+        let tail = xc.len() * LANES;
+        for (((x, z), uk), wk) in xc.zip(zc).zip(uc).zip(wc) {
+            let (ul, wl) = self.velocity_lanes::<LANES>(
+                x.try_into().expect("chunk of LANES"),
+                z.try_into().expect("chunk of LANES"),
+            );
+            uk.copy_from_slice(&ul);
+            wk.copy_from_slice(&wl);
+        }
+        for k in tail..px.len() {
+            (u[k], w[k]) = self.velocity_at(px[k], pz[k]);
+        }
+    }
+
+    /// The sheet velocity at `L` points, each lane computed independently.
+    #[inline(always)]
+    fn velocity_lanes<const L: usize>(&self, px: &[f64; L], pz: &[f64; L]) -> ([f64; L], [f64; L]) {
+        // σ: the root of x + iz − c/2 = −(c/4)(σ + 1/σ) outside the unit circle
+        let (mut sgr, mut sgi) = ([0.0; L], [0.0; L]);
+        for k in 0..L {
+            let (dx, dz) = (px[k] - self.le[0], pz[k] - self.le[1]);
+            let x = dx * self.t[0] + dz * self.t[1];
+            let z = dx * self.n[0] + dz * self.n[1];
+            // s = 2(x + iz − c/2)/c; σ = −s ± √(s² − 1)
+            let (sr, si) = (2.0 * x / self.c - 1.0, 2.0 * z / self.c);
+            let (qr, qi) = csqrt(sr * sr - si * si - 1.0, 2.0 * sr * si);
+            let (a, b) = ((-sr + qr, -si + qi), (-sr - qr, -si - qi));
+            let pick_a = a.0 * a.0 + a.1 * a.1 >= b.0 * b.0 + b.1 * b.1;
+            sgr[k] = if pick_a { a.0 } else { b.0 };
+            sgi[k] = if pick_a { a.1 } else { b.1 };
+        }
+        // F = u − iw = −i[2B0/(σ − 1) + Σ B_n σ^{−n}], 1/(σ − 1) regularised
+        let (mut fr, mut fi) = ([0.0; L], [0.0; L]);
+        let (mut rr, mut ri) = ([0.0; L], [0.0; L]);
+        for k in 0..L {
+            let (er, ei) = (sgr[k] - 1.0, sgi[k]);
+            let m2 = er * er + ei * ei;
+            let inv = 1.0 / (m2 * m2 + self.eps4).sqrt();
+            fr[k] = 2.0 * self.b[0] * (er * inv);
+            fi[k] = 2.0 * self.b[0] * (-ei * inv);
+            let d2 = sgr[k] * sgr[k] + sgi[k] * sgi[k];
+            (rr[k], ri[k]) = (sgr[k] / d2, -sgi[k] / d2); // 1/σ
+        }
+        let (mut pr, mut pi) = ([1.0; L], [0.0; L]);
         for &bn in &self.b[1..] {
-            (pr, pi) = (pr * rr - pi * ri, pr * ri + pi * rr);
-            fr += bn * pr;
-            fi += bn * pi;
+            for k in 0..L {
+                (pr[k], pi[k]) = (pr[k] * rr[k] - pi[k] * ri[k], pr[k] * ri[k] + pi[k] * rr[k]);
+                fr[k] += bn * pr[k];
+                fi[k] += bn * pi[k];
+            }
         }
         // multiply by −i: (fr + i fi)(−i) = fi − i fr  →  u = fi, w = fr
-        let (u, w) = (fi, fr);
-        (u * self.t[0] + w * self.n[0], u * self.t[1] + w * self.n[1])
+        let (mut u, mut w) = ([0.0; L], [0.0; L]);
+        for k in 0..L {
+            u[k] = fi[k] * self.t[0] + fr[k] * self.n[0];
+            w[k] = fi[k] * self.t[1] + fr[k] * self.n[1];
+        }
+        (u, w)
     }
 }
 
 /// Principal square root of a + ib.
+#[inline(always)]
 fn csqrt(a: f64, b: f64) -> (f64, f64) {
-    let r = a.hypot(b);
+    // |a + ib| without `hypot`'s overflow guard: the arguments are O(1) (chord-scaled)
+    let r = (a * a + b * b).sqrt();
     let re = (0.5 * (r + a)).max(0.0).sqrt();
     let im = (0.5 * (r - a)).max(0.0).sqrt();
     (re, if b < 0.0 { -im } else { im })

@@ -22,7 +22,7 @@
 //! the leading-edge suction parameter is LESP = A0 = B0/U_ref.
 //!
 //! Each step: (1) convect the free vortices with the velocities of the previous step (forward
-//! Euler, Vatistas n = 2 core r_c between free vortices, the exact velocity of the truncated
+//! Euler, Vatistas n = 2 cores between free vortices, each growing by viscous diffusion, the exact velocity of the truncated
 //! bound sheet from the conformal map, vortices that would cross the plate mirrored back), (2) decay, delete and amalgamate them, (3) place a new
 //! trailing-edge vortex (TEV) 1/3 of the way from the trailing edge to the previous TEV and solve
 //! Kelvin's condition Γ_bound + Σ Γ_free = 0 for its strength, (4) if |LESP| > LESP_crit also place
@@ -151,7 +151,8 @@ impl Default for MergeParams {
 /// | `n_chord` | 24 | chord collocation points (θ uniform in [0, π]; also the bound elements) |
 /// | `n_fourier` | 10 | Fourier terms B0..B_{n−1} |
 /// | `lesp_crit` | Some(0.15) | critical LESP; `None` turns LEV shedding off |
-/// | `core_radius_frac` | 0.02 | Vatistas core radius r_c / c |
+/// | `core_radius_frac` | 0.02 | Vatistas core radius r_c / c of a new vortex |
+/// | `core_growth_reynolds` | Some(1000) | Re = U_ref c/ν of the viscous core growth (Lamb–Oseen) |
 /// | `suction_factor` | 1.0 | multiplies the leading-edge suction ρπcB0² |
 /// | `lev_decay_chords` | Some(4.0) | LEV circulation decays as exp(−s/s_d), s = plate travel / c |
 /// | `tev_decay_chords` | Some(40.0) | same for trailing-edge (wake) vortices |
@@ -183,8 +184,12 @@ pub struct LdvmParams {
     pub n_fourier: usize,
     /// Critical leading-edge suction parameter; `None` disables LEV shedding.
     pub lesp_crit: Option<f64>,
-    /// Vortex core radius r_c / c.
+    /// Core radius r_c / c of a newly shed vortex.
     pub core_radius_frac: f64,
+    /// Viscous core growth: each free vortex's core grows as a Lamb–Oseen vortex,
+    /// r_c² = r_c0² + 5.0257·ν·t, with ν·t = s·c²/Re for s chords of plate travel since it was
+    /// shed (Re = U_ref·c/ν). `None` keeps every core at r_c0 (inviscid).
+    pub core_growth_reynolds: Option<f64>,
     /// Factor on the leading-edge suction force (1 = thin-airfoil suction, 0 = none).
     pub suction_factor: f64,
     /// LEV decay length s_d (chords of plate travel); `None` = no decay.
@@ -210,6 +215,7 @@ impl Default for LdvmParams {
             n_fourier: 10,
             lesp_crit: Some(0.15),
             core_radius_frac: 0.02,
+            core_growth_reynolds: Some(1000.0),
             suction_factor: 1.0,
             lev_decay_chords: Some(4.0),
             tev_decay_chords: Some(40.0),
@@ -228,6 +234,7 @@ impl LdvmParams {
             chord_m,
             u_ref_m_s,
             lesp_crit: None,
+            core_growth_reynolds: None,
             lev_decay_chords: None,
             tev_decay_chords: None,
             far_field_chords: None,
@@ -287,6 +294,7 @@ impl LdvmParams {
             );
         }
         for (name, v) in [
+            ("core_growth_reynolds", self.core_growth_reynolds),
             ("lev_decay_chords", self.lev_decay_chords),
             ("tev_decay_chords", self.tev_decay_chords),
             ("far_field_chords", self.far_field_chords),

@@ -214,7 +214,7 @@ impl SectionModel for StripLdvm {
         let u_max = [
             kin.speed_m_s(),
             self.prev_kin.speed_m_s(),
-            p.u_ref_m_s,
+            ldvm.reference_speed(),
             kin.rotation_rate_rad_s.abs() * edge,
             self.prev_kin.rotation_rate_rad_s.abs() * edge,
         ]

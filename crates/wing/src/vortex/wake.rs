@@ -4,6 +4,10 @@
 //! Velocity induced at point P by a counter-clockwise vortex Γ (m²/s) at P_k, d = P − P_k:
 //!
 //! u = Γ/(2π) · (−d_z, d_x) / sqrt(r_c⁴ + |d|⁴)   (m/s).
+//!
+//! Each vortex has its own core radius r_c,k (it grows by viscous diffusion, see
+//! [`LdvmParams::core_growth_reynolds`](super::LdvmParams::core_growth_reynolds)); between two free
+//! vortices the pair core is r_c² = (r_c,j² + r_c,k²)/2.
 
 use std::f64::consts::PI;
 
@@ -41,11 +45,21 @@ pub struct Wake {
     x: Vec<f64>,
     z: Vec<f64>,
     gamma: Vec<f64>,
+    /// Core radius squared r_c² (m²) of each vortex.
+    core2: Vec<f64>,
     kind: Vec<VortexKind>,
     u: Vec<f64>,
     w: Vec<f64>,
     keep: Vec<bool>,
     best: Vec<(f64, u32, u32)>,
+    /// Amalgamation workspace: distance to the plate d (m), weight (D0 + d)^{−3/2} and the
+    /// measures of one vortex's pairs.
+    plate_dist: Vec<f64>,
+    merge_weight: Vec<f64>,
+    pair_measure: Vec<f64>,
+    /// Pair-loop workspace of `compute_velocities`.
+    pair_fx: Vec<f64>,
+    pair_fz: Vec<f64>,
     /// Index of the newest TEV / LEV (protected from merging; used to place the next one).
     pub(crate) last_tev: Option<usize>,
     pub(crate) last_lev: Option<usize>,
@@ -53,9 +67,15 @@ pub struct Wake {
     /// removal, `clear_wake`) (m²/s): it still counts in Kelvin's theorem, as vortices at
     /// infinity that induce no velocity, so a deletion does not force the plate to shed.
     far_circulation: f64,
+    /// r_c² (m²) of a newly shed vortex.
+    new_core2: f64,
 }
 
-/// Adds to (u, w) the velocity at (px, pz) induced by vortices (xs, zs, gs).
+/// Lanes of the symmetric pair loop's sums: `LANES` independent partial sums vectorize (a fixed
+/// summation order: deterministic results).
+const LANES: usize = 8;
+
+/// The velocity (m/s) at (px, pz) induced by vortices (xs, zs, gs).
 #[inline(always)]
 pub(crate) fn induced_at(
     px: f64,
@@ -78,20 +98,28 @@ pub(crate) fn induced_at(
 }
 
 impl Wake {
-    /// Empty wake able to hold `capacity` vortices without reallocating.
-    pub fn with_capacity(capacity: usize) -> Self {
+    /// Empty wake able to hold `capacity` vortices without reallocating; new vortices get the
+    /// core radius `core_radius_m` (m).
+    pub fn with_capacity(capacity: usize, core_radius_m: f64) -> Self {
         Self {
             x: Vec::with_capacity(capacity),
             z: Vec::with_capacity(capacity),
             gamma: Vec::with_capacity(capacity),
+            core2: Vec::with_capacity(capacity),
             kind: Vec::with_capacity(capacity),
             u: Vec::with_capacity(capacity),
             w: Vec::with_capacity(capacity),
             keep: Vec::with_capacity(capacity),
             best: Vec::with_capacity(capacity),
+            plate_dist: Vec::with_capacity(capacity),
+            merge_weight: Vec::with_capacity(capacity),
+            pair_measure: Vec::with_capacity(capacity),
+            pair_fx: Vec::with_capacity(capacity),
+            pair_fz: Vec::with_capacity(capacity),
             last_tev: None,
             last_lev: None,
             far_circulation: 0.0,
+            new_core2: core_radius_m * core_radius_m,
         }
     }
 
@@ -100,6 +128,7 @@ impl Wake {
         self.x.clear();
         self.z.clear();
         self.gamma.clear();
+        self.core2.clear();
         self.kind.clear();
         self.u.clear();
         self.w.clear();
@@ -160,9 +189,50 @@ impl Wake {
         self.far_circulation
     }
 
+    /// Core radii r_c (m).
+    pub fn core_radii_m(&self) -> impl Iterator<Item = f64> + '_ {
+        self.core2.iter().map(|c2| c2.sqrt())
+    }
+
     /// Velocity (m/s) induced at (px, pz) by all free vortices.
-    pub fn velocity_at(&self, px: f64, pz: f64, rc4: f64) -> (f64, f64) {
-        induced_at(px, pz, &self.x, &self.z, &self.gamma, rc4)
+    pub fn velocity_at(&self, px: f64, pz: f64) -> (f64, f64) {
+        let (mut u, mut w) = (0.0, 0.0);
+        self.velocities_at(
+            &[px],
+            &[pz],
+            std::slice::from_mut(&mut u),
+            std::slice::from_mut(&mut w),
+        );
+        (u, w)
+    }
+
+    /// Velocities (m/s) induced by all free vortices at the points (px, pz), written to (u, w);
+    /// each point's sum runs over the vortices in order. The loop runs over the
+    /// vortices outside and over the points inside, so the inner loop has no reduction and
+    /// vectorizes.
+    pub fn velocities_at(&self, px: &[f64], pz: &[f64], u: &mut [f64], w: &mut [f64]) {
+        let n = px.len();
+        assert!(
+            pz.len() == n && u.len() == n && w.len() == n,
+            "point slices differ in length"
+        );
+        u.fill(0.0);
+        w.fill(0.0);
+        for (((&x, &z), &g), &c2) in self.x.iter().zip(&self.z).zip(&self.gamma).zip(&self.core2) {
+            let rc4 = c2 * c2;
+            for (((&pxk, &pzk), uk), wk) in px.iter().zip(pz).zip(u.iter_mut()).zip(w.iter_mut()) {
+                let dx = pxk - x;
+                let dz = pzk - z;
+                let d2 = dx * dx + dz * dz;
+                let f = g / (rc4 + d2 * d2).sqrt();
+                *uk -= dz * f;
+                *wk += dx * f;
+            }
+        }
+        for (uk, wk) in u.iter_mut().zip(w.iter_mut()) {
+            *uk /= 2.0 * PI;
+            *wk /= 2.0 * PI;
+        }
     }
 
     /// Appends a vortex; returns its index. The caller guarantees `len() < capacity()`.
@@ -171,6 +241,7 @@ impl Wake {
         self.x.push(x);
         self.z.push(z);
         self.gamma.push(gamma);
+        self.core2.push(self.new_core2);
         self.kind.push(kind);
         self.u.push(0.0);
         self.w.push(0.0);
@@ -187,33 +258,65 @@ impl Wake {
         (self.x[i], self.z[i])
     }
 
-    /// Sets (u, w) of every vortex to the velocity induced by the other free vortices plus
-    /// `sheet(x, z)`, the velocity of the bound vortex sheet at (x, z). O(N²/2 + N·cost(sheet)).
-    pub(crate) fn compute_velocities(&mut self, rc4: f64, sheet: impl Fn(f64, f64) -> (f64, f64)) {
+    /// Sets (u, w) of every vortex to the velocity induced by the other free vortices plus that
+    /// of the bound vortex sheet, which `sheet(x, z, u, w)` writes for the points (x, z).
+    /// O(N²/2 + N·cost(sheet)).
+    pub(crate) fn compute_velocities(
+        &mut self,
+        sheet: impl Fn(&[f64], &[f64], &mut [f64], &mut [f64]),
+    ) {
         let n = self.len();
-        for i in 0..n {
-            let (u, w) = sheet(self.x[i], self.z[i]);
-            self.u[i] = u;
-            self.w[i] = w;
-        }
+        sheet(&self.x, &self.z, &mut self.u, &mut self.w);
         let inv2pi = 1.0 / (2.0 * PI);
+        let (xs, zs, gs) = (&self.x[..n], &self.z[..n], &self.gamma[..n]);
+        let cs = &self.core2[..n];
+        let (us, ws) = (&mut self.u[..n], &mut self.w[..n]);
+        self.pair_fx.resize(n, 0.0);
+        self.pair_fz.resize(n, 0.0);
         for i in 0..n {
-            let (xi, zi, gi) = (self.x[i], self.z[i], self.gamma[i]);
-            let (mut ui, mut wi) = (0.0, 0.0);
-            for j in (i + 1)..n {
-                let dx = xi - self.x[j];
-                let dz = zi - self.z[j];
+            let (xi, zi, gi, ci) = (xs[i], zs[i], gs[i], cs[i]);
+            // j > i: d·f/Γ_j (velocity at i per unit Γ_j, rotated) and the velocity at j from i
+            let (fx, fz) = (&mut self.pair_fx[i + 1..n], &mut self.pair_fz[i + 1..n]);
+            let (ut, wt) = (&mut us[i + 1..], &mut ws[i + 1..]);
+            for ((((((&xj, &zj), &cj), fxj), fzj), uj), wj) in xs[i + 1..]
+                .iter()
+                .zip(&zs[i + 1..])
+                .zip(&cs[i + 1..])
+                .zip(fx.iter_mut())
+                .zip(fz.iter_mut())
+                .zip(ut.iter_mut())
+                .zip(wt.iter_mut())
+            {
+                let (dx, dz) = (xi - xj, zi - zj);
                 let d2 = dx * dx + dz * dz;
-                let f = inv2pi / (rc4 + d2 * d2).sqrt();
-                // velocity at i from j, and at j from i (d reversed)
-                let gj = self.gamma[j];
-                ui -= dz * f * gj;
-                wi += dx * f * gj;
-                self.u[j] += dz * f * gi;
-                self.w[j] -= dx * f * gi;
+                let rc2 = 0.5 * (ci + cj);
+                let f = inv2pi / (rc2 * rc2 + d2 * d2).sqrt();
+                (*fxj, *fzj) = (dx * f, dz * f);
+                *uj += *fzj * gi;
+                *wj -= *fxj * gi;
             }
-            self.u[i] += ui;
-            self.w[i] += wi;
+            // velocity at i: Σ_j Γ_j (−fz, fx) in LANES partial sums
+            let gt = &gs[i + 1..];
+            let (mut ul, mut wl) = ([0.0; LANES], [0.0; LANES]);
+            let (fxc, fzc, gc) = (
+                fx.chunks_exact(LANES),
+                fz.chunks_exact(LANES),
+                gt.chunks_exact(LANES),
+            );
+            let (fxr, fzr, gr) = (fxc.remainder(), fzc.remainder(), gc.remainder());
+            for ((a, b), g) in fxc.zip(fzc).zip(gc) {
+                for k in 0..LANES {
+                    ul[k] -= b[k] * g[k];
+                    wl[k] += a[k] * g[k];
+                }
+            }
+            let (mut ui, mut wi) = (ul.iter().sum::<f64>(), wl.iter().sum::<f64>());
+            for ((a, b), g) in fxr.iter().zip(fzr).zip(gr) {
+                ui += -(b * g);
+                wi += a * g;
+            }
+            us[i] += ui;
+            ws[i] += wi;
         }
     }
 
@@ -231,6 +334,13 @@ impl Wake {
                 self.x[i] -= 2.0 * z1 * after.n[0];
                 self.z[i] -= 2.0 * z1 * after.n[1];
             }
+        }
+    }
+
+    /// Adds `d_core2_m2` to every core radius squared (viscous diffusion over a step).
+    pub(crate) fn grow_cores(&mut self, d_core2_m2: f64) {
+        for c2 in &mut self.core2 {
+            *c2 += d_core2_m2;
         }
     }
 
@@ -286,37 +396,61 @@ impl Wake {
         let seg2 = (seg[0] * seg[0] + seg[1] * seg[1]).max(f64::MIN_POSITIVE);
         let dist = |x: f64, z: f64| {
             let s = (((x - le[0]) * seg[0] + (z - le[1]) * seg[1]) / seg2).clamp(0.0, 1.0);
-            (x - le[0] - s * seg[0]).hypot(z - le[1] - s * seg[1])
+            let (dx, dz) = (x - le[0] - s * seg[0], z - le[1] - s * seg[1]);
+            (dx * dx + dz * dz).sqrt()
         };
         let protected = |i: usize, s: &Self| s.last_tev == Some(i) || s.last_lev == Some(i);
         let forced = n > target;
+        // per vortex: distance to the plate and the weight (D0 + d)^{−3/2}, infinite for a
+        // vortex that may not merge (the newest TEV/LEV; near the plate unless forced), so that
+        // its measure is ∞ (or NaN), never below the best
+        self.plate_dist.clear();
+        self.merge_weight.clear();
+        for i in 0..n {
+            let d = dist(self.x[i], self.z[i]);
+            let e = d0_m + d;
+            let eligible = !protected(i, self) && (forced || d >= near_m);
+            self.plate_dist.push(d);
+            self.merge_weight.push(if eligible {
+                1.0 / (e * e.sqrt())
+            } else {
+                f64::INFINITY
+            });
+        }
+        self.pair_measure.clear();
+        self.pair_measure.resize(n, f64::INFINITY);
         self.best.clear();
         for i in 0..n {
-            let di = dist(self.x[i], self.z[i]);
-            if protected(i, self) || (!forced && di < near_m) {
+            let (xi, zi, gi, wi) = (self.x[i], self.z[i], self.gamma[i], self.merge_weight[i]);
+            if wi == f64::INFINITY {
                 continue;
             }
-            let gi = self.gamma[i];
+            // the merge measure of (i, j) for every j > i (vectorized), then the first smallest
+            // that does not cross the plate
+            let (xs, zs, gs) = (&self.x[i + 1..n], &self.z[i + 1..n], &self.gamma[i + 1..n]);
+            let (ws, ms) = (
+                &self.merge_weight[i + 1..n],
+                &mut self.pair_measure[i + 1..n],
+            );
+            for ((((&xj, &zj), &gj), &wj), m) in
+                xs.iter().zip(zs).zip(gs).zip(ws).zip(ms.iter_mut())
+            {
+                let (dx, dz) = (xi - xj, zi - zj);
+                let dij = (dx * dx + dz * dz).sqrt();
+                let mij = (gi * gj).abs() / (gi + gj).abs() * dij * (wi * wj);
+                *m = if gi * gj > 0.0 { mij } else { f64::INFINITY };
+            }
+            let di = self.plate_dist[i];
             let mut best = (f64::INFINITY, 0u32);
             for j in (i + 1)..n {
-                let gj = self.gamma[j];
-                if gi * gj <= 0.0 || protected(j, self) {
-                    continue;
-                }
-                let dj = dist(self.x[j], self.z[j]);
-                if !forced && dj < near_m {
-                    continue;
-                }
-                let dij = (self.x[i] - self.x[j]).hypot(self.z[i] - self.z[j]);
-                let m =
-                    (gi * gj).abs() / (gi + gj).abs() * dij / ((d0_m + di) * (d0_m + dj)).powf(1.5);
+                let m = self.pair_measure[j];
                 // never merge across the plate: the merged vortex must not lie closer to it
                 // than both constituents (it would sit on the plate)
                 if m < best.0 {
-                    let g = gi + gj;
-                    let xm = (gi * self.x[i] + gj * self.x[j]) / g;
-                    let zm = (gi * self.z[i] + gj * self.z[j]) / g;
-                    if dist(xm, zm) >= 0.999 * di.min(dj) {
+                    let (gj, g) = (self.gamma[j], gi + self.gamma[j]);
+                    let xm = (gi * xi + gj * self.x[j]) / g;
+                    let zm = (gi * zi + gj * self.z[j]) / g;
+                    if dist(xm, zm) >= 0.999 * di.min(self.plate_dist[j]) {
                         best = (m, j as u32);
                     }
                 }
@@ -342,6 +476,8 @@ impl Wake {
             let g = gi + gj;
             self.x[i] = (gi * self.x[i] + gj * self.x[j]) / g;
             self.z[i] = (gi * self.z[i] + gj * self.z[j]) / g;
+            // |Γ|-weighted core (same-sign pair: weights Γ/ΣΓ are positive)
+            self.core2[i] = (gi * self.core2[i] + gj * self.core2[j]) / g;
             self.u[i] = (gi * self.u[i] + gj * self.u[j]) / g;
             self.w[i] = (gi * self.w[i] + gj * self.w[j]) / g;
             if gj.abs() > gi.abs() {
@@ -388,6 +524,7 @@ impl Wake {
             self.x[dst] = self.x[src];
             self.z[dst] = self.z[src];
             self.gamma[dst] = self.gamma[src];
+            self.core2[dst] = self.core2[src];
             self.kind[dst] = self.kind[src];
             self.u[dst] = self.u[src];
             self.w[dst] = self.w[src];
@@ -404,6 +541,7 @@ impl Wake {
         self.x.truncate(dst);
         self.z.truncate(dst);
         self.gamma.truncate(dst);
+        self.core2.truncate(dst);
         self.kind.truncate(dst);
         self.u.truncate(dst);
         self.w.truncate(dst);
@@ -420,7 +558,7 @@ mod tests {
     fn amalgamation_never_merges_across_the_plate() {
         let (le, te) = ([0.0, 0.0], [1.0, 0.0]);
         for (zb, expect) in [(-0.1, 3), (0.12, 2)] {
-            let mut wake = Wake::with_capacity(8);
+            let mut wake = Wake::with_capacity(8, 0.01);
             wake.push(0.5, 0.1, 1.0, VortexKind::Lev);
             wake.push(0.55, zb, 1.0, VortexKind::Lev);
             wake.push(5.0, 5.0, -1.0, VortexKind::Lev); // newest: protected
@@ -434,7 +572,7 @@ mod tests {
     /// circulation in the Kelvin balance; `clear` (a reset) forgets it.
     #[test]
     fn removed_vortices_keep_their_circulation_at_infinity() {
-        let mut wake = Wake::with_capacity(8);
+        let mut wake = Wake::with_capacity(8, 0.01);
         wake.push(0.0, 0.0, 0.3, VortexKind::Tev);
         wake.push(20.0, 0.0, -0.2, VortexKind::Tev);
         wake.push(0.5, 0.0, 0.05, VortexKind::Lev);
@@ -447,13 +585,39 @@ mod tests {
         assert!((wake.far_circulation() - 0.1).abs() < 1e-15);
         assert!((wake.total_circulation() - 0.85).abs() < 1e-15);
         // removed vortices induce nothing
-        let (u, w) = wake.velocity_at(0.5, 1.0, 1e-8);
+        let (u, w) = wake.velocity_at(0.5, 1.0);
         let (u2, w2) = induced_at(0.5, 1.0, &[0.5, 1.0], &[0.0, 0.0], &[0.05, 0.7], 1e-8);
-        assert_eq!((u, w), (u2, w2));
+        assert!((u - u2).abs() < 1e-15 && (w - w2).abs() < 1e-15);
         wake.remove_all_to_far();
         assert!(wake.is_empty() && (wake.total_circulation() - 0.85).abs() < 1e-15);
         wake.clear();
         assert_eq!(wake.total_circulation(), 0.0);
+    }
+
+    /// Grown cores: a vortex induces with its own core at the points, and a pair of free
+    /// vortices with the mean of their r_c².
+    #[test]
+    fn grown_cores_set_the_induced_velocity() {
+        let mut wake = Wake::with_capacity(4, 0.01);
+        wake.push(0.0, 0.0, 1.0, VortexKind::Tev);
+        wake.grow_cores(0.03 * 0.03 - 0.01 * 0.01);
+        wake.push(0.02, 0.0, 0.5, VortexKind::Tev);
+        let r: Vec<f64> = wake.core_radii_m().collect();
+        assert!((r[0] - 0.03).abs() < 1e-15 && (r[1] - 0.01).abs() < 1e-15);
+        let (u, w) = wake.velocity_at(0.0, 0.02);
+        let (u0, w0) = induced_at(0.0, 0.02, &[0.0], &[0.0], &[1.0], 0.03f64.powi(4));
+        let (u1, w1) = induced_at(0.0, 0.02, &[0.02], &[0.0], &[0.5], 0.01f64.powi(4));
+        assert!((u - u0 - u1).abs() < 1e-12 && (w - w0 - w1).abs() < 1e-12);
+        wake.compute_velocities(|_, _, u, w| {
+            u.fill(0.0);
+            w.fill(0.0);
+        });
+        let rc2: f64 = 0.5 * (0.03 * 0.03 + 0.01 * 0.01);
+        let (_, w1) = induced_at(0.02, 0.0, &[0.0], &[0.0], &[1.0], rc2 * rc2);
+        assert!(
+            (wake.w[1] - w1).abs() < 1e-12
+                && w1 < induced_at(0.02, 0.0, &[0.0], &[0.0], &[1.0], 1e-8).1
+        );
     }
 
     #[test]
@@ -467,7 +631,7 @@ mod tests {
 
     #[test]
     fn pair_velocities_match_direct_sum_and_merging_conserves_circulation() {
-        let mut wake = Wake::with_capacity(16);
+        let mut wake = Wake::with_capacity(16, 0.01);
         let pts = [
             (0.0, 0.0, 1.0),
             (0.3, 0.1, -0.5),
@@ -480,7 +644,10 @@ mod tests {
             wake.push(x, z, g, VortexKind::Tev);
         }
         let rc4 = 0.01f64.powi(4);
-        wake.compute_velocities(rc4, |_, _| (0.0, 0.0));
+        wake.compute_velocities(|_, _, u, w| {
+            u.fill(0.0);
+            w.fill(0.0);
+        });
         for (i, &(x, z, _)) in pts.iter().enumerate() {
             let (mut u, mut w) = (0.0, 0.0);
             for (j, &(xj, zj, gj)) in pts.iter().enumerate() {
