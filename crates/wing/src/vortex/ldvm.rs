@@ -2,7 +2,7 @@
 
 use std::f64::consts::PI;
 
-use super::wake::{PlateFrame, Wake, induced_at};
+use super::wake::{LANES, PlateFrame, Wake, induced_at};
 use super::{LdvmParams, MergeParams, VortexError, VortexKind};
 
 /// Pose and velocity of the plate in the inertial plane.
@@ -578,7 +578,6 @@ impl BoundSheet<'_> {
     /// Velocities (m/s) at the points (px, pz), written to (u, w): [`BoundSheet::velocity_at`]
     /// bit for bit, computed for `LANES` points at a time so that it vectorizes.
     pub fn velocities_at(&self, px: &[f64], pz: &[f64], u: &mut [f64], w: &mut [f64]) {
-        const LANES: usize = 8;
         let (xc, zc) = (px.chunks_exact(LANES), pz.chunks_exact(LANES));
         let (uc, wc) = (u.chunks_exact_mut(LANES), w.chunks_exact_mut(LANES));
         let tail = xc.len() * LANES;

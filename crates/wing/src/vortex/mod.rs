@@ -22,8 +22,9 @@
 //! the leading-edge suction parameter is LESP = A0 = B0/U_ref.
 //!
 //! Each step: (1) convect the free vortices with the velocities of the previous step (forward
-//! Euler, Vatistas n = 2 cores between free vortices, each growing by viscous diffusion, the exact velocity of the truncated
-//! bound sheet from the conformal map, vortices that would cross the plate mirrored back), (2) decay, delete and amalgamate them, (3) place a new
+//! Euler, Vatistas n = 2 cores between free vortices, each growing by viscous diffusion, the
+//! exact velocity of the truncated bound sheet from the conformal map, vortices that would cross
+//! the plate mirrored back), (2) decay, delete and amalgamate them, (3) place a new
 //! trailing-edge vortex (TEV) 1/3 of the way from the trailing edge to the previous TEV and solve
 //! Kelvin's condition Γ_bound + Σ Γ_free = 0 for its strength, (4) if |LESP| > LESP_crit also place
 //! a leading-edge vortex (LEV) and solve the 2×2 system {Kelvin, B0 = ±LESP_crit·U_ref} for both

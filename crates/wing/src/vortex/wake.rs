@@ -71,9 +71,9 @@ pub struct Wake {
     new_core2: f64,
 }
 
-/// Lanes of the symmetric pair loop's sums: `LANES` independent partial sums vectorize (a fixed
-/// summation order: deterministic results).
-const LANES: usize = 8;
+/// Lanes of the vectorized loops: the symmetric pair loop's `LANES` independent partial sums (a
+/// fixed summation order: deterministic results) and the bound sheet's points per block.
+pub(crate) const LANES: usize = 8;
 
 /// The velocity (m/s) at (px, pz) induced by vortices (xs, zs, gs).
 #[inline(always)]
