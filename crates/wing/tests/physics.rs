@@ -548,6 +548,10 @@ fn invalid_l2_settings_are_refused_by_name() {
         .to_string();
     assert!(e.contains("core_radius_frac"), "{e}");
     cfg.l2.ldvm.core_radius_frac = 0.02;
+    cfg.l2.profile_drag = -0.1;
+    let e = cfg.check().unwrap_err().to_string();
+    assert!(e.contains("profile_drag"), "{e}");
+    cfg.l2.profile_drag = 0.26;
     assert!(cfg.check().is_ok());
 }
 

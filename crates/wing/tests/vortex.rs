@@ -786,21 +786,16 @@ fn wing_l2_hover_stays_in_the_dataset_ranges() {
     assert!(cm.0 >= -11.0 && cm.1 <= 13.0, "C_M range {cm:?}");
 }
 
-/// Cycle-mean C_L of the L2 hover in [1.0, 1.8] (physics notes §4.4.9), averaged over cycles
-/// 2–4 (after the impulsive start): 1.77 (1.66 / 1.82 / 1.82). The wake makes single cycles
-/// scatter: over cycles 2–10 they range 1.66–1.91 (mean 1.79), against 1.75 at L0
-/// (docs/vortex-method.md, round 7).
+/// Cycle-mean C_L of the L2 hover in [1.0, 1.8] (physics notes §4.4.9) in every cycle 2–4
+/// (after the impulsive start): 1.54 / 1.69 / 1.69 (mean 1.64); over cycles 2–10 they range
+/// 1.54–1.78 (mean 1.66), against 1.75 at L0 (docs/vortex-method.md, round 8). Before the
+/// strip's profile drag (round 7) the cycles reached 1.82–1.91.
 #[test]
 fn wing_l2_hover_mean_lift_in_band() {
     let (cl, _, _) = l2_hover_coefficients();
-    let mean = cl[1..].iter().sum::<f64>() / (cl.len() - 1) as f64;
     assert!(
-        (1.0..=1.8).contains(&mean),
-        "cycles 2–4: mean C_L = {mean} ({cl:?})"
-    );
-    assert!(
-        cl[1..].iter().all(|c| (1.0..=2.0).contains(c)),
-        "per-cycle C_L {cl:?}"
+        cl[1..].iter().all(|c| (1.0..=1.8).contains(c)),
+        "per-cycle C_L, cycles 1–4: {cl:?}"
     );
 }
 
@@ -926,4 +921,38 @@ fn strip_hover_circulation_stays_bounded() {
     println!("strip hover, 6 cycles: max |Γ| {max_gamma:.3} m²/s, max |N'| {max_normal:.1} N/m");
     assert!(max_gamma < 0.5, "max |Γ| = {max_gamma} m²/s");
     assert!(max_normal < 60.0, "max |N'| = {max_normal} N/m");
+}
+
+/// Profile drag: a strip sliding along its chord (zero incidence, no rotation) sheds nothing
+/// and has no bound circulation, so its only load is the chordwise drag −C_D0·½ρcU² against
+/// the motion (C_D0 = 0.260, the L0 model's zero-incidence drag at Re = 1000), for either
+/// direction; `profile_drag = 0` gives the inviscid plate's zero load.
+#[test]
+fn strip_profile_drag_at_zero_incidence() {
+    use flapssm_wing::vortex::strip::zero_incidence_drag;
+    let c0 = zero_incidence_drag();
+    assert!((c0 - 0.260).abs() < 5e-4, "C_D0 = {c0}");
+    let geom = rcp_section();
+    for (drag, speed) in [(c0, 0.4), (c0, -0.4), (0.0, 0.4)] {
+        let params = StripLdvmParams {
+            profile_drag: drag,
+            ..Default::default()
+        };
+        let mut strip = StripLdvm::new(params, &geom);
+        let kin = SectionKinematics {
+            chord_velocity_m_s: speed,
+            ..Default::default()
+        };
+        let mut loads = strip.step(&kin, 0.0);
+        for _ in 0..200 {
+            loads = strip.step(&kin, 0.004);
+        }
+        let expected = -drag * 0.5 * 800.0 * 0.06 * speed.abs() * speed;
+        assert!(
+            (loads.chordwise_n_m - expected).abs() < 1e-9 * expected.abs().max(1.0),
+            "C_D0 {drag}, t {speed} m/s: T' = {} N/m, expected {expected}",
+            loads.chordwise_n_m
+        );
+        assert!(loads.normal_n_m.abs() < 1e-9 && loads.moment_n.abs() < 1e-9);
+    }
 }

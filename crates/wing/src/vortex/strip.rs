@@ -40,13 +40,30 @@
 //! The normal force and the pitching moment are multiplied by `cn_3d_factor` (default 0.8 for the
 //! AR = 3 plate: between the lifting-line slope ratio AR/(AR + 2) = 0.6 of attached flow and ≈ 1
 //! for the LEV-dominated, high-α loads of revolving wings). The suction force is not scaled.
+//!
+//! # Profile drag
+//!
+//! The LDVM is inviscid and the plate infinitely thin: its only chordwise force is the
+//! leading-edge suction. The strip adds the chordwise drag of the real plate (skin friction and
+//! edge pressure), T_d = −C_D0·½ρc·U·t (N/m, along +y_w; t the chordwise velocity, U the
+//! speed), i.e. C_D0·q·cos α_g against the chordwise motion. C_D0 = `profile_drag` defaults to the
+//! zero-incidence drag of the L0 model, [`zero_incidence_drag`] = 0.260: the Dickinson C_D(0°)
+//! = 0.393 with the Blasius friction of the fits' Re ≈ 150 (0.217) replaced by that of
+//! Re = 1000 (0.084).
 
 use serde::{Deserialize, Serialize};
 
 use super::{Ldvm, LdvmParams, PlateState, VortexError};
+use crate::aero::quasi_steady::{blasius_skin_friction, dickinson_drag};
 use crate::aero::{
     SectionGeometry, SectionKinematics, SectionLoads, SectionModel, SectionModelFactory,
 };
+
+/// Zero-incidence chordwise drag coefficient of the plate at Re = 1000 (dimensionless):
+/// C_D(0°) − C_f(Re 150) + C_f(Re 1000) = 0.260 (Dickinson fit, Blasius friction on both faces).
+pub fn zero_incidence_drag() -> f64 {
+    dickinson_drag(0.0) - blasius_skin_friction(150.0) + blasius_skin_friction(1000.0)
+}
 
 /// Parameters of the L2 section model (the LDVM template; chord, pivot and density are taken
 /// from the [`SectionGeometry`] of each strip).
@@ -61,6 +78,9 @@ pub struct StripLdvmParams {
     pub max_step_chords: f64,
     /// Cap on the sub-steps per sample interval (default 8).
     pub max_substeps: usize,
+    /// Chordwise profile-drag coefficient C_D0 (dimensionless, default
+    /// [`zero_incidence_drag`] = 0.260; 0 gives the inviscid plate).
+    pub profile_drag: f64,
 }
 
 impl StripLdvmParams {
@@ -96,6 +116,13 @@ impl StripLdvmParams {
                 reason: "must be >= 1",
             });
         }
+        if !(self.profile_drag.is_finite() && self.profile_drag >= 0.0) {
+            return Err(VortexError::InvalidParameter {
+                name: "profile_drag",
+                value: self.profile_drag,
+                reason: "must be finite and >= 0",
+            });
+        }
         self.section_params(section).check()
     }
 }
@@ -112,6 +139,7 @@ impl Default for StripLdvmParams {
             cn_3d_factor: 0.8,
             max_step_chords: 0.0125,
             max_substeps: 8,
+            profile_drag: zero_incidence_drag(),
         }
     }
 }
@@ -134,6 +162,8 @@ impl SectionModelFactory for StripLdvmFactory {
 pub struct StripLdvm {
     ldvm: Option<Ldvm>,
     cn_3d_factor: f64,
+    /// C_D0·½ρc (kg/m²).
+    drag_factor: f64,
     max_step_m: f64,
     max_substeps: usize,
     prev_kin: SectionKinematics,
@@ -154,6 +184,7 @@ impl StripLdvm {
                 .ok()
                 .filter(|_| valid),
             cn_3d_factor: params.cn_3d_factor,
+            drag_factor: params.profile_drag * 0.5 * section.density_kg_m3 * section.chord_m,
             max_step_m: params.max_step_chords * section.chord_m,
             max_substeps: params.max_substeps,
             prev_kin: SectionKinematics::default(),
@@ -295,7 +326,7 @@ impl StripLdvm {
         let l = ldvm.step(&self.plate, dt).ok()?;
         Some(SectionLoads {
             normal_n_m: self.cn_3d_factor * l.normal_n_m,
-            chordwise_n_m: -l.chord_n_m,
+            chordwise_n_m: -l.chord_n_m - self.drag_factor * speed * kin.chord_velocity_m_s,
             moment_n: self.cn_3d_factor * l.moment_pivot_n,
         })
     }
