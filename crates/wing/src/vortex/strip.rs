@@ -54,15 +54,16 @@
 use serde::{Deserialize, Serialize};
 
 use super::{Ldvm, LdvmParams, PlateState, VortexError};
-use crate::aero::quasi_steady::{blasius_skin_friction, dickinson_drag};
+use crate::aero::quasi_steady::{QuasiSteadyParams, translational_coefficients};
 use crate::aero::{
     SectionGeometry, SectionKinematics, SectionLoads, SectionModel, SectionModelFactory,
 };
 
-/// Zero-incidence chordwise drag coefficient of the plate at Re = 1000 (dimensionless):
+/// Zero-incidence chordwise drag coefficient of the plate at Re = 1000 (dimensionless): the
+/// default L0 model's chordwise coefficient for motion along the chord, with its sign turned,
 /// C_D(0°) − C_f(Re 150) + C_f(Re 1000) = 0.260 (Dickinson fit, Blasius friction on both faces).
 pub fn zero_incidence_drag() -> f64 {
-    dickinson_drag(0.0) - blasius_skin_friction(150.0) + blasius_skin_friction(1000.0)
+    -translational_coefficients(0.0, 1.0, &QuasiSteadyParams::default()).c_t
 }
 
 /// Parameters of the L2 section model (the LDVM template; chord, pivot and density are taken
