@@ -14,7 +14,7 @@
 //! with `H = K` (unwhitened: `Σ K⊙W = kᵀ(K_mm)⁻¹k`) or `H = W` (whitened: `Σ W² = ‖L⁻¹k‖²`).
 //! Cost per batch: `O(M D N)` kernel and one `M × M × N` product; the reverse mode needs two
 //! more (`K̄ = Gᵀ W̄`, `Ḡ += W̄ Kᵀ`). `Ḡ` is mapped to `K̄_mm` once per evaluation
-//! ([`Posterior::kmm_grad`]).
+//! (`Posterior::kmm_grad`).
 
 use faer::Accum;
 

@@ -16,7 +16,7 @@
 //! = (1/n_k) Σ_{i∈k} (y_i − b₀ − x_iᵀ b)²; `cv_mse_mean` is the mean over the K folds and
 //! `cv_mse_se` their standard deviation (ddof 1) / √K. `index_min` = argmin of the mean
 //! (first on ties); `index_1se` = the largest λ (smallest index) with
-//! mean ≤ mean[index_min] + se[index_min].
+//! `mean ≤ mean[index_min] + se[index_min]`.
 //!
 //! ## Cost
 //! Only first and second moments of the data enter, so the rows are read once: per fold the

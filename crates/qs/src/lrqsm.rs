@@ -189,13 +189,13 @@ impl DatasetPrediction {
     ///
     /// | array | shape | meaning |
     /// |---|---|---|
-    /// | `y_pred` | [n_traj, n_t, 5] | predicted outputs (N, N·mm) |
-    /// | `y_pred_standardized` | [n_traj, n_t, 5] | predicted standardized outputs |
-    /// | `is_train` | [n_traj] | training trajectory flags |
-    /// | `output_names` | [5] | |
+    /// | `y_pred` | `[n_traj, n_t, 5]` | predicted outputs (N, N·mm) |
+    /// | `y_pred_standardized` | `[n_traj, n_t, 5]` | predicted standardized outputs |
+    /// | `is_train` | `[n_traj]` | training trajectory flags |
+    /// | `output_names` | `[5]` | |
     /// | `intercept` | () | whether the intercept was added |
-    /// | `rmse_train`, `rmse_test` | [5] | RMSE in output units (absent without outputs/data) |
-    /// | `rmse_train_standardized`, `rmse_test_standardized` | [5] | RMSE / σ_y |
+    /// | `rmse_train`, `rmse_test` | `[5]` | RMSE in output units (absent without outputs/data) |
+    /// | `rmse_train_standardized`, `rmse_test_standardized` | `[5]` | RMSE / σ_y |
     ///
     /// # Errors
     /// [`QsError::Io`] on write failure.

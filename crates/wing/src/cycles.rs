@@ -208,7 +208,7 @@ impl PublishedWindow {
 
 /// The published one-cycle window (`fplotter.m`) of a sampled stroke angle φ (rad):
 ///
-/// 1. δ = φ[N−1] − φ[N−2]; among samples 0..N−10, the last 10 with |φ[i] − φ[N−1]| < |δ|;
+/// 1. δ = φ\[N−1\] − φ\[N−2\]; among samples 0..N−10, the last 10 with |φ\[i\] − φ\[N−1\]| < |δ|;
 ///    keep the last index of each run of consecutive indices; `ind` is the second-to-last of
 ///    those (the previous crossing of the final value in the same direction);
 /// 2. `duration = N − ind` (1-based `ind`), `first = floor(N − 5·duration/4)` (1-based),

@@ -137,7 +137,7 @@ impl WingKinematics {
     /// Wing kinematics from the rotation matrix R_0w(t) (wing → global, any global frame) and
     /// its first and second time derivatives:
     ///
-    /// [ω]× = Rᵀ Ṙ,  [ω̇]× = Rᵀ R̈ − [ω]×².
+    /// `[ω]× = Rᵀ Ṙ`, `[ω̇]× = Rᵀ R̈ − [ω]×²`.
     ///
     /// The skew parts are extracted by antisymmetrisation, so small errors in numerically
     /// differentiated matrices do not bias ω. A constant global rotation Q (R → Q R) leaves the
@@ -224,7 +224,7 @@ pub fn transpose(a: &Mat3) -> Mat3 {
     t
 }
 
-/// Skew-symmetric cross-product matrix [w]×, with [w]× u = w × u.
+/// Skew-symmetric cross-product matrix `[w]×`, with `[w]× u = w × u`.
 pub fn skew(w: [f64; 3]) -> Mat3 {
     [[0.0, -w[2], w[1]], [w[2], 0.0, -w[0]], [-w[1], w[0], 0.0]]
 }

@@ -5,10 +5,10 @@
 //! - [`schedule`]: learning-rate schedules.
 //! - [`adam`]: the Adam optimizer.
 //! - [`batches`]: windows, shuffled minibatches and seed derivation.
-//! - [`bench`]: speed measurements of the paper's configuration.
+//! - [`bench`](mod@bench): speed measurements of the paper's configuration.
 //! - [`checkpoint`]: the complete run state, saved atomically.
 //! - [`initial`]: initial-state rules and the ELBO with a recognition model.
-//! - [`fit`]: presets and fitting a PR-SSM to raw sequences; prediction with its rule.
+//! - [`fit`](mod@fit): presets and fitting a PR-SSM to raw sequences; prediction with its rule.
 //! - [`recognition`]: the recognition model `(u, y)_{0..k} ↦ N(m₀, diag(s₀²))`.
 //! - [`trainer`]: the training loop [`train`].
 
