@@ -17,6 +17,7 @@ use std::time::Instant;
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use flapssm_prssm::predict::predict;
+use flapssm_prssm::train::bench::{gemm_rate_gflops, predict_step_flops, train_step_flops};
 use flapssm_prssm::{
     Elbo, ElboOptions, ModelConfig, Objective, ParamInit, Params, Sequence, TrainingData, Window,
 };
@@ -52,26 +53,6 @@ fn setup() -> (Elbo, Vec<f64>, ModelConfig, Params, Vec<f64>) {
     (elbo, theta, config, params, u)
 }
 
-/// FLOPs of one forward + backward transition step for N points (dominant terms of the
-/// algorithm, prssm-notes §4): `W = G K`, `K̄ = Gᵀ W̄`, `Ḡ += W̄ Kᵀ` (6 M²N), the kernel
-/// distances and their two adjoint products (6 M D N), mean/variance products and their
-/// adjoints (12 M D_x N). Paper configuration, N = 480: 41 MFLOP.
-fn step_flops(n: usize) -> f64 {
-    let (m, d, dx) = (100.0, 19.0, 12.0);
-    let n = n as f64;
-    6.0 * m * m * n + 6.0 * m * n * d + 12.0 * m * dx * n
-}
-
-/// FLOPs of one forward-only prediction step for P particles (dominant terms):
-/// `[W; μ] = [G; mᵀG] K` (`2 (M + D_x) M P`), the variance product `S(W⊙W)` (`2 D_x M P`)
-/// and the kernel distances of the state part (`2 M D_x P`). Paper configuration, P = 30:
-/// 0.82 MFLOP.
-fn predict_step_flops(p: usize) -> f64 {
-    let (m, dx) = (100.0, 12.0);
-    let p = p as f64;
-    2.0 * (m + dx) * m * p + 2.0 * dx * m * p + 2.0 * m * dx * p
-}
-
 /// CPU time (user + system) of this process so far, seconds (Linux `/proc/self/stat`,
 /// 100 ticks per second); `None` elsewhere.
 fn cpu_seconds() -> Option<f64> {
@@ -83,13 +64,15 @@ fn cpu_seconds() -> Option<f64> {
 
 fn bench(c: &mut Criterion) {
     let (elbo, theta, config, params, u) = setup();
+    let gemm = gemm_rate_gflops(512, 0.3);
+    println!("f64 GEMM 512 x 512 x 512 (faer, one thread): {gemm:.1} GFLOP/s per core");
     if std::env::var_os("PREDICT_ONLY").is_none() {
-        bench_elbo(c, &elbo, &theta);
+        bench_elbo(c, &elbo, &theta, gemm);
     }
-    bench_predict(c, &config, &params, &u);
+    bench_predict(c, &config, &params, &u, gemm);
 }
 
-fn bench_elbo(c: &mut Criterion, elbo: &Elbo, theta: &[f64]) {
+fn bench_elbo(c: &mut Criterion, elbo: &Elbo, theta: &[f64], gemm: f64) {
     let mut grad = vec![0.0; theta.len()];
     let mut g = c.benchmark_group("elbo");
     g.sample_size(10);
@@ -130,25 +113,31 @@ fn bench_elbo(c: &mut Criterion, elbo: &Elbo, theta: &[f64]) {
     times.sort_by(f64::total_cmp);
     let tb = times[2];
     let epoch = 32.0 * tb;
-    let gflops = step_flops(480) * (T - 1) as f64 / tb / 1e9;
+    let step_flops = train_step_flops(elbo.config(), 480);
+    let gflops = step_flops * (T - 1) as f64 / tb / 1e9;
     println!(
         "minibatch (16 × 470 × 30) forward+backward: {tb:.3} s (median of 5); projected epoch \
          (512 seqs): {epoch:.2} s (authors: 81.8 s, {:.1}× faster); {gflops:.1} GFLOP/s; threads: {}",
         81.8 / epoch,
         rayon::current_num_threads()
     );
+    let threads = rayon::current_num_threads() as f64;
+    println!(
+        "  {:.0} % of {threads} × the GEMM rate; all FLOP at that rate: {:.2} s per epoch",
+        100.0 * gflops / (threads * gemm),
+        epoch * gflops / (threads * gemm)
+    );
     if let Some(cpu) = cpu {
-        let threads = rayon::current_num_threads() as f64;
         println!(
             "  CPU time per minibatch {cpu:.3} s → epoch on {threads} idle cores ≈ {:.2} s \
              ({:.1} GFLOP/s per core)",
             32.0 * cpu / threads,
-            step_flops(480) * (T - 1) as f64 / cpu / 1e9
+            step_flops * (T - 1) as f64 / cpu / 1e9
         );
     }
 }
 
-fn bench_predict(c: &mut Criterion, config: &ModelConfig, params: &Params, u: &[f64]) {
+fn bench_predict(c: &mut Criterion, config: &ModelConfig, params: &Params, u: &[f64], gemm: f64) {
     let zero = vec![0.0; 12];
     let reps = 100;
     let cpu0 = cpu_seconds();
@@ -158,13 +147,14 @@ fn bench_predict(c: &mut Criterion, config: &ModelConfig, params: &Params, u: &[
     }
     let wall = t0.elapsed().as_secs_f64() / reps as f64;
     if let Some(cpu) = cpu_seconds().zip(cpu0).map(|(a, b)| (a - b) / reps as f64) {
+        let rate = predict_step_flops(config, 30) * (T - 1) as f64 / cpu / 1e9;
         println!(
             "prediction (470 steps × 30 particles, one thread): {:.2} ms wall, {:.2} ms CPU \
-             (authors: 152 ms, {:.0}× faster; {:.1} GFLOP/s)",
+             (authors: 152 ms, {:.0}× faster; {rate:.1} GFLOP/s = {:.0} % of the GEMM rate)",
             1e3 * wall,
             1e3 * cpu,
             0.152 / cpu,
-            predict_step_flops(30) * (T - 1) as f64 / cpu / 1e9
+            100.0 * rate / gemm
         );
     }
     let mut g = c.benchmark_group("predict");

@@ -4,10 +4,9 @@
 use anyhow::Context;
 use clap::Args;
 use flapssm_prssm::train::bench::{
-    AUTHORS_EPOCH_S, AUTHORS_PREDICT_S, PREDICT_FLOP_PER_POINT_STEP, TRAIN_FLOP_PER_POINT_STEP,
-    paper_model, paper_objective, time_batches, time_prediction, time_stream_step,
+    AUTHORS_EPOCH_S, AUTHORS_PREDICT_S, gemm_rate_gflops, paper_model, paper_objective,
+    predict_step_flops, time_batches, time_prediction, time_stream_step,
 };
-
 /// Measure training, prediction and streaming speed (release build, this machine).
 #[derive(Args)]
 pub struct BenchArgs {
@@ -25,31 +24,41 @@ pub struct BenchArgs {
 /// Runs `flapssm bench`.
 pub fn run(args: BenchArgs) -> anyhow::Result<()> {
     let threads = rayon::current_num_threads();
+    let gemm = gemm_rate_gflops(512, 0.3);
+    println!("this machine: f64 GEMM (512 x 512 x 512, faer, 1 thread) {gemm:.1} GFLOP/s per core");
     let (elbo, params) =
         paper_objective(512, 470, args.seed).context("building the paper objective")?;
     let n_batches = usize::from(args.batches);
-    let (secs, points) =
+    let (secs, flop) =
         time_batches(&elbo, &params, n_batches, args.seed).context("timing training batches")?;
     let epoch_s = secs * 32.0 / n_batches as f64;
+    let rate = flop / secs / 1e9;
+    let limit = threads as f64 * gemm;
     println!(
         "training epoch (512 seq x 470 steps x 30 particles, batch 16, {threads} threads): {epoch_s:.3} s \
-         ({n_batches} batches timed), {:.1} GFLOP/s est., {:.1}x faster than the authors' {AUTHORS_EPOCH_S} s",
-        points * TRAIN_FLOP_PER_POINT_STEP / secs / 1e9,
+         ({n_batches} batches timed), {:.1}x faster than the authors' {AUTHORS_EPOCH_S} s",
         AUTHORS_EPOCH_S / epoch_s
+    );
+    println!(
+        "  {rate:.1} GFLOP/s = {:.0} % of {threads} x the GEMM rate; all FLOP at that rate: {:.2} s per epoch",
+        100.0 * rate / limit,
+        epoch_s * rate / limit
     );
     let model = paper_model(args.seed);
     let pred_s = time_prediction(&model, 470, 30, args.reps).context("timing prediction")?;
+    let pred_rate = 469.0 * predict_step_flops(&model.config, 30) / pred_s / 1e9;
     println!(
-        "prediction (470 steps x 30 particles, 1 thread): {:.3} ms, {:.1} GFLOP/s est., {:.1}x faster than the authors' {AUTHORS_PREDICT_S} s",
+        "prediction (470 steps x 30 particles, 1 thread): {:.3} ms, {pred_rate:.1} GFLOP/s ({:.0} % of the GEMM rate), \
+         {:.1}x faster than the authors' {AUTHORS_PREDICT_S} s",
         pred_s * 1e3,
-        470.0 * 30.0 * PREDICT_FLOP_PER_POINT_STEP / pred_s / 1e9,
+        100.0 * pred_rate / gemm,
         AUTHORS_PREDICT_S / pred_s
     );
     let step_s = time_stream_step(&model, 30, 2000).context("timing streaming")?;
     println!(
-        "streaming step (30 particles): {:.1} us, {:.1} GFLOP/s est.",
+        "streaming step (30 particles): {:.1} us, {:.1} GFLOP/s",
         step_s * 1e6,
-        30.0 * PREDICT_FLOP_PER_POINT_STEP / step_s / 1e9
+        predict_step_flops(&model.config, 30) / step_s / 1e9
     );
     Ok(())
 }

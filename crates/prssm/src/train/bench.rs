@@ -1,31 +1,80 @@
 //! Speed measurements of the paper's configuration (used by `flapssm bench` and the
-//! criterion benches), on synthetic data of the paper's shapes.
-//!
-//! FLOP estimates (prssm-notes §4): a training step of the paper's shapes costs ≈ 45 MFLOP
-//! forward + backward for `N = 480` particle-windows, i.e. [`TRAIN_FLOP_PER_POINT_STEP`] per
-//! particle, window and time step; a prediction step ≈ 14 MFLOP / 480 =
-//! [`PREDICT_FLOP_PER_POINT_STEP`] per particle and step.
+//! criterion benches), on synthetic data of the paper's shapes, with the FLOP model that
+//! turns times into GFLOP/s and the machine's own GEMM rate that bounds them.
 
 use std::time::Instant;
+
+use faer::linalg::matmul::matmul;
+use faer::{Accum, Mat, Par};
 
 use super::batches::{BatchPlan, WindowSpec, derive_seed};
 use super::fit::{FitSpec, Preset};
 use crate::elbo::{Elbo, ElboError, ElboOptions, Sequence, TrainingData};
 use crate::model::PrssmModel;
-use crate::params::Params;
+use crate::params::{ModelConfig, Params};
 use crate::predict;
 use crate::stream::StreamPredictor;
 use crate::systems::random_input;
 use crate::{Objective, ObjectiveError, Window};
 
-/// Estimated FLOP per (particle, window, step) of a training step (forward + backward).
-pub const TRAIN_FLOP_PER_POINT_STEP: f64 = 45e6 / 480.0;
-/// Estimated FLOP per (particle, step) of prediction (forward only).
-pub const PREDICT_FLOP_PER_POINT_STEP: f64 = 14e6 / 480.0;
 /// The authors' code: one training epoch (s), prssm-notes §3.
 pub const AUTHORS_EPOCH_S: f64 = 81.8;
 /// The authors' code: prediction of one 470-step trajectory with 30 particles (s).
 pub const AUTHORS_PREDICT_S: f64 = 0.152;
+
+/// FLOP of one training transition step (forward + backward) of `n_points`
+/// particle-windows, dominant terms: the three `M × M × N` products `W = G K`, `K̄ = Gᵀ W̄`
+/// and `Ḡ += W̄ Kᵀ` (`6 M² N`), the kernel distances and their two adjoint products
+/// (`6 M D N`), the mean and variance products and their adjoints (`12 M D_x N`).
+/// Paper configuration (`M` 100, `D` 19, `D_x` 12), `N = 480`: 41 MFLOP.
+pub fn train_step_flops(config: &ModelConfig, n_points: usize) -> f64 {
+    let (m, d, dx) = (
+        config.n_inducing as f64,
+        config.n_gp_input() as f64,
+        config.n_state as f64,
+    );
+    let n = n_points as f64;
+    6.0 * m * m * n + 6.0 * m * d * n + 12.0 * m * dx * n
+}
+
+/// FLOP of one forward-only prediction step of `particles` particles, dominant terms:
+/// `[W; μ] = [G; mᵀG] K` (`2 (M + D_x) M P`), the variance product `S (W ⊙ W)`
+/// (`2 D_x M P`) and the state part of the kernel distances (`2 M D_x P`).
+/// Paper configuration, `P = 30`: 0.82 MFLOP.
+pub fn predict_step_flops(config: &ModelConfig, particles: usize) -> f64 {
+    let (m, dx) = (config.n_inducing as f64, config.n_state as f64);
+    let p = particles as f64;
+    2.0 * (m + dx) * m * p + 2.0 * dx * m * p + 2.0 * m * dx * p
+}
+
+/// This machine's f64 matrix-product rate on one thread (GFLOP/s): the best of repeated
+/// `size × size × size` faer products over at least `min_seconds`. Near the core's FLOP
+/// limit, it bounds what the engine (≈ 70 % of its FLOP in such products) can reach.
+pub fn gemm_rate_gflops(size: usize, min_seconds: f64) -> f64 {
+    let size = size.max(8);
+    let a = Mat::<f64>::from_fn(size, size, |i, j| ((i * 31 + j * 17) % 97) as f64 / 97.0);
+    let b = Mat::<f64>::from_fn(size, size, |i, j| ((i * 13 + j * 29) % 89) as f64 / 89.0);
+    let mut c = Mat::<f64>::zeros(size, size);
+    let flop = 2.0 * (size as f64).powi(3);
+    let mut best = f64::INFINITY;
+    let start = Instant::now();
+    let mut reps = 0;
+    while reps < 3 || start.elapsed().as_secs_f64() < min_seconds {
+        let t0 = Instant::now();
+        matmul(
+            c.as_mut(),
+            Accum::Replace,
+            a.as_ref(),
+            b.as_ref(),
+            1.0,
+            Par::Seq,
+        );
+        best = best.min(t0.elapsed().as_secs_f64());
+        std::hint::black_box(&c);
+        reps += 1;
+    }
+    flop / best / 1e9
+}
 
 /// `n` synthetic sequences of `len` steps with 7 smooth random inputs and 5 outputs
 /// (standardized scale), seeded.
@@ -66,7 +115,7 @@ pub fn paper_objective(
 }
 
 /// Times `n_batches` minibatches (batch 16 whole sequences) of `objective` at `params`;
-/// returns (seconds, number of (particle, window, step) points processed).
+/// returns (seconds, FLOP by [`train_step_flops`] of the transitions computed).
 ///
 /// # Errors
 /// The objective's error.
@@ -83,15 +132,20 @@ pub fn time_batches(
     plan.epoch_order(seed, 0, &mut order);
     let mut batch: Vec<Window> = Vec::new();
     let mut grad = vec![0.0; objective.n_params()];
-    let particles = objective.options().particles as f64;
-    let mut points = 0.0;
+    let particles = objective.options().particles;
+    let mut flop = 0.0;
     let t0 = Instant::now();
     for b in 0..n_batches.min(plan.batches_per_epoch()) {
         plan.batch_into(&order, b, &mut batch);
         objective.loss_and_grad(params, &batch, derive_seed(seed, 2, b as u64), &mut grad)?;
-        points += batch.iter().map(|w| w.len as f64).sum::<f64>() * particles;
+        flop += batch
+            .iter()
+            .map(|w| {
+                w.len.saturating_sub(1) as f64 * train_step_flops(objective.config(), particles)
+            })
+            .sum::<f64>();
     }
-    Ok((t0.elapsed().as_secs_f64(), points))
+    Ok((t0.elapsed().as_secs_f64(), flop))
 }
 
 /// A paper-shaped model (fresh parameters) for prediction timings.
@@ -157,4 +211,28 @@ pub fn time_stream_step(
         std::hint::black_box(m);
     }
     Ok(t0.elapsed().as_secs_f64() / steps.max(1) as f64)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The FLOP model against a hand count for the paper's shapes (M 100, D 19, D_x 12):
+    /// `6·100²·480 + 6·100·19·480 + 12·100·12·480` and `2·112·100·30 + 2·12·100·30 + 2·100·12·30`.
+    #[test]
+    fn flop_model_of_the_paper_configuration() {
+        let spec = FitSpec::preset(Preset::Paper, 7, 5);
+        let train = train_step_flops(&spec.model, 480);
+        assert_eq!(train, 28_800_000.0 + 5_472_000.0 + 6_912_000.0);
+        let predict = predict_step_flops(&spec.model, 30);
+        assert_eq!(predict, 672_000.0 + 72_000.0 + 72_000.0);
+        // Both are linear in the number of points.
+        assert_eq!(train_step_flops(&spec.model, 30) * 16.0, train);
+    }
+
+    #[test]
+    fn gemm_rate_is_a_finite_positive_rate() {
+        let r = gemm_rate_gflops(16, 0.0);
+        assert!(r.is_finite() && r > 0.0, "{r}");
+    }
 }
