@@ -17,7 +17,9 @@ use std::time::Instant;
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use flapssm_prssm::predict::predict;
-use flapssm_prssm::train::bench::{gemm_rate_gflops, predict_step_flops, train_step_flops};
+use flapssm_prssm::train::bench::{
+    AUTHORS_EPOCH_S, AUTHORS_PREDICT_S, gemm_rate_gflops, predict_step_flops, train_step_flops,
+};
 use flapssm_prssm::{
     Elbo, ElboOptions, ModelConfig, Objective, ParamInit, Params, Sequence, TrainingData, Window,
 };
@@ -117,8 +119,8 @@ fn bench_elbo(c: &mut Criterion, elbo: &Elbo, theta: &[f64], gemm: f64) {
     let gflops = step_flops * (T - 1) as f64 / tb / 1e9;
     println!(
         "minibatch (16 × 470 × 30) forward+backward: {tb:.3} s (median of 5); projected epoch \
-         (512 seqs): {epoch:.2} s (authors: 81.8 s, {:.1}× faster); {gflops:.1} GFLOP/s; threads: {}",
-        81.8 / epoch,
+         (512 seqs): {epoch:.2} s (authors: {AUTHORS_EPOCH_S} s, {:.1}× faster); {gflops:.1} GFLOP/s; threads: {}",
+        AUTHORS_EPOCH_S / epoch,
         rayon::current_num_threads()
     );
     let threads = rayon::current_num_threads() as f64;
@@ -150,10 +152,11 @@ fn bench_predict(c: &mut Criterion, config: &ModelConfig, params: &Params, u: &[
         let rate = predict_step_flops(config, 30) * (T - 1) as f64 / cpu / 1e9;
         println!(
             "prediction (470 steps × 30 particles, one thread): {:.2} ms wall, {:.2} ms CPU \
-             (authors: 152 ms, {:.0}× faster; {rate:.1} GFLOP/s = {:.0} % of the GEMM rate)",
+             (authors: {:.0} ms, {:.0}× faster; {rate:.1} GFLOP/s = {:.0} % of the GEMM rate)",
             1e3 * wall,
             1e3 * cpu,
-            0.152 / cpu,
+            1e3 * AUTHORS_PREDICT_S,
+            AUTHORS_PREDICT_S / cpu,
             100.0 * rate / gemm
         );
     }

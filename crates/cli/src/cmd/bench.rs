@@ -7,6 +7,10 @@ use flapssm_prssm::train::bench::{
     AUTHORS_EPOCH_S, AUTHORS_PREDICT_S, gemm_rate_gflops, paper_model, paper_objective,
     predict_step_flops, time_batches, time_prediction, time_stream_step,
 };
+
+/// Steps of the timed prediction (the authors' trajectory length).
+const PREDICT_STEPS: usize = 470;
+
 /// Measure training, prediction and streaming speed (release build, this machine).
 #[derive(Args)]
 pub struct BenchArgs {
@@ -45,8 +49,10 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
         epoch_s * rate / limit
     );
     let model = paper_model(args.seed);
-    let pred_s = time_prediction(&model, 470, 30, args.reps).context("timing prediction")?;
-    let pred_rate = 469.0 * predict_step_flops(&model.config, 30) / pred_s / 1e9;
+    let pred_s =
+        time_prediction(&model, PREDICT_STEPS, 30, args.reps).context("timing prediction")?;
+    let transitions = (PREDICT_STEPS - 1) as f64;
+    let pred_rate = transitions * predict_step_flops(&model.config, 30) / pred_s / 1e9;
     println!(
         "prediction (470 steps x 30 particles, 1 thread): {:.3} ms, {pred_rate:.1} GFLOP/s ({:.0} % of the GEMM rate), \
          {:.1}x faster than the authors' {AUTHORS_PREDICT_S} s",

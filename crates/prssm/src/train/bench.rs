@@ -134,7 +134,7 @@ pub fn time_batches(
     plan.epoch_order(seed, 0, &mut order);
     let mut batch: Vec<Window> = Vec::new();
     let mut grad = vec![0.0; objective.n_params()];
-    let particles = objective.options().particles;
+    let window_step_flops = train_step_flops(objective.config(), objective.options().particles);
     let mut flop = 0.0;
     plan.batch_into(&order, 0, &mut batch);
     objective.loss_and_grad(params, &batch, derive_seed(seed, 3, 0), &mut grad)?;
@@ -142,12 +142,8 @@ pub fn time_batches(
     for b in 0..n_batches.min(plan.batches_per_epoch()) {
         plan.batch_into(&order, b, &mut batch);
         objective.loss_and_grad(params, &batch, derive_seed(seed, 2, b as u64), &mut grad)?;
-        flop += batch
-            .iter()
-            .map(|w| {
-                w.len.saturating_sub(1) as f64 * train_step_flops(objective.config(), particles)
-            })
-            .sum::<f64>();
+        let transitions: usize = batch.iter().map(|w| w.len.saturating_sub(1)).sum();
+        flop += transitions as f64 * window_step_flops;
     }
     Ok((t0.elapsed().as_secs_f64(), flop))
 }
