@@ -37,6 +37,37 @@ pub fn robofly_hover_state(t: f64, f: f64) -> EulerState {
     }
 }
 
+/// Hovering figure-of-eight at `f` Hz: the Robofly stroke φ = 80° sin x (x = 2πft) with the
+/// deviation ψ = −Ψ sin 2x (`deviation_amp_rad` = Ψ; the tip falls through mid-stroke and rises
+/// through both reversals, as the generator's figure-eight family), and the tanh-shaped pitch
+/// of [`robofly_hover_state`] with its plateau deepened by atan(2Ψ/Φ), so that the mid-stroke
+/// AoA is 45° again despite the descent. Analytic rates and accelerations.
+pub fn figure_eight_hover_state(t: f64, f: f64, deviation_amp_rad: f64) -> EulerState {
+    let amp = 80f64.to_radians();
+    let w = 2.0 * PI * f;
+    let x = w * t;
+    let dev = deviation_amp_rad;
+    let robofly = robofly_hover_state(t, f);
+    let pitch_scale = (FRAC_PI_4 + (2.0 * dev / amp).atan()) / FRAC_PI_4;
+    EulerState {
+        angles_rad: [
+            amp * x.sin(),
+            -dev * (2.0 * x).sin(),
+            pitch_scale * robofly.angles_rad[2],
+        ],
+        rates_rad_s: [
+            amp * w * x.cos(),
+            -2.0 * dev * w * (2.0 * x).cos(),
+            pitch_scale * robofly.rates_rad_s[2],
+        ],
+        accels_rad_s2: [
+            -amp * w * w * x.sin(),
+            4.0 * dev * w * w * (2.0 * x).sin(),
+            pitch_scale * robofly.accels_rad_s2[2],
+        ],
+    }
+}
+
 /// (φ, ψ, α) → (−φ, ψ, −α): the kinematics mirrored in the wing frame's x_w (F_x, M_y, M_z
 /// change sign, F_y and M_x do not).
 pub fn mirrored(states: &[EulerState]) -> Vec<EulerState> {
