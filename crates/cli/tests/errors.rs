@@ -228,6 +228,15 @@ fn bad_inputs_are_refused_naming_the_file_and_writing_nothing() {
             ],
             vec!["future.json", "version 99"],
         ),
+        // unknown fidelity level
+        (
+            vec!["simulate", "--n", "2", "--fidelity", "l3", "--out", "OUT"],
+            vec!["--fidelity", "l3"],
+        ),
+        (
+            vec!["demo", "--fidelity", "l3", "--out", "OUT"],
+            vec!["--fidelity", "l3"],
+        ),
         // no outputs to train on
         (
             vec!["train", &p("kin.npz"), "--out", "OUT"],

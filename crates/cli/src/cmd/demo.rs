@@ -38,6 +38,10 @@ pub struct DemoArgs {
     /// Override the number of training particles.
     #[arg(long)]
     particles: Option<usize>,
+    /// Override the virtual wing's aerodynamic fidelity: l0 (quasi-steady), l1 (unsteady
+    /// low-order, the default generator), l2 (vortex strips).
+    #[arg(long, value_name = "LEVEL")]
+    fidelity: Option<String>,
 }
 
 /// Progress bars: one per stage, lines printed above.
@@ -159,6 +163,9 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
     }
     if let Some(p) = args.particles {
         cfg.training.particles = Some(p);
+    }
+    if let Some(f) = &args.fidelity {
+        cfg.simulation.wing.fidelity = f.parse().context("parsing --fidelity")?;
     }
     let stop = stop_flag()?;
     let bars = Bars::new();
