@@ -350,7 +350,7 @@ fn default_trajectories_move_leading_edge_first() {
 /// default wing and generator, and the normal-force wing on a flat stroke plane. A study, not a
 /// check: `cargo test --release -p flapssm-wing --test memory -- --ignored --nocapture`.
 #[test]
-#[ignore = "study: prints the L2 memory figures (≈ 30 s)"]
+#[ignore = "study: prints the L2 memory figures (≈ 20 s)"]
 fn study_l2_memory_evidence() {
     memory(false, Chordwise::Full, Fidelity::L2);
     memory(true, Chordwise::FrictionOnly, Fidelity::L2);
