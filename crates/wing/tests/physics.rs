@@ -2,7 +2,7 @@
 
 mod common;
 
-use common::{blade, figure_eight_hover_state, mirrored, robofly_hover_state};
+use common::{blade, figure_eight_hover_state, lift_n, mirrored, robofly_hover_state};
 
 use flapssm_wing::aero::blade_element::BladeElement;
 use flapssm_wing::aero::quasi_steady::{
@@ -396,6 +396,22 @@ fn time_scaling_invariance() {
     }
 }
 
+/// Asserts that sample `i` of the dataset plate's loads `y` (N, N·mm) lies inside the
+/// dataset's plotted ranges: C_F ∈ [−4, 7] with `q_s` = ½ρSU_ref² (N), C_M ∈ [−11, 13] with
+/// q_s·c̄ (c̄ = 0.06 m).
+fn assert_in_dataset_ranges(y: &[f64; 5], q_s: f64, fidelity: Fidelity, i: usize) {
+    let cf = [y[0] / q_s, y[1] / q_s];
+    let cm = [2, 3, 4].map(|c| y[c] / (1e3 * q_s * 0.06));
+    assert!(
+        cf.iter().all(|v| (-4.0..=7.0).contains(v)),
+        "{fidelity:?} sample {i}: C_F {cf:?}"
+    );
+    assert!(
+        cm.iter().all(|v| (-11.0..=13.0).contains(v)),
+        "{fidelity:?} sample {i}: C_M {cm:?}"
+    );
+}
+
 /// Robofly-like hovering: φ = 80° sin(2πft), ψ = 0, symmetric rotation with α = ∓45° at
 /// mid-stroke (AoA = 45°). Robofly convention for the mean lift coefficient (Sane & Dickinson
 /// 2001): C̄_L = L̄ / (½ρc ∫r²dr · mean φ̇²) in [1.0, 1.8]; dataset convention (½ρSU_ref²,
@@ -420,19 +436,9 @@ fn hovering_sanity() {
         wg.aero_loads_into(&states, dt, &mut y);
         let (mut lift, mut phi_dot2) = (0.0, 0.0);
         for i in n - per_cycle..n {
-            let r = flapssm_wing::kinematics::rotation_global_from_wing(&states[i].angles_rad);
-            lift += r[1][0] * y[i][0] + r[1][1] * y[i][1];
+            lift += lift_n(&states[i], &y[i]);
             phi_dot2 += states[i].rates_rad_s[0].powi(2);
-            let cf = [y[i][0] / q_s, y[i][1] / q_s];
-            let cm = [2, 3, 4].map(|c| y[i][c] / (1e3 * q_s * 0.06));
-            assert!(
-                cf.iter().all(|v| (-4.0..=7.0).contains(v)),
-                "{fidelity:?} C_F {cf:?}"
-            );
-            assert!(
-                cm.iter().all(|v| (-11.0..=13.0).contains(v)),
-                "{fidelity:?} C_M {cm:?}"
-            );
+            assert_in_dataset_ranges(&y[i], q_s, fidelity, i);
         }
         let cl = lift / per_cycle as f64 / q_robofly(phi_dot2 / per_cycle as f64);
         let mid = n - per_cycle;
@@ -488,19 +494,9 @@ fn hovering_figure_eight_sanity() {
         for cycle in 1..cycles {
             let (mut lift, mut speed2) = (0.0, 0.0);
             for i in cycle * per_cycle..(cycle + 1) * per_cycle {
-                let r = flapssm_wing::kinematics::rotation_global_from_wing(&states[i].angles_rad);
-                lift += r[1][0] * y[i][0] + r[1][1] * y[i][1];
+                lift += lift_n(&states[i], &y[i]);
                 speed2 += WingKinematics::from_euler(&states[i]).speed.powi(2);
-                let cf = [y[i][0] / q_s, y[i][1] / q_s];
-                let cm = [2, 3, 4].map(|c| y[i][c] / (1e3 * q_s * 0.06));
-                assert!(
-                    cf.iter().all(|v| (-4.0..=7.0).contains(v)),
-                    "{fidelity:?} sample {i}: C_F {cf:?}"
-                );
-                assert!(
-                    cm.iter().all(|v| (-11.0..=13.0).contains(v)),
-                    "{fidelity:?} sample {i}: C_M {cm:?}"
-                );
+                assert_in_dataset_ranges(&y[i], q_s, fidelity, i);
             }
             mean_cl.push(lift / (0.5 * 800.0 * 0.06 * i2 * speed2));
         }

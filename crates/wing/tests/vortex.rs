@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::{blade, mirrored, robofly_hover_state};
+use common::{blade, lift_n, mirrored, robofly_hover_state};
 use std::f64::consts::PI;
 
 use flapssm_wing::vortex::{Ldvm, LdvmParams, PlateState, SectionLoads, VortexKind};
@@ -650,7 +650,7 @@ fn study_hover_spikes() {
 use flapssm_wing::aero::blade_element::BladeElement;
 use flapssm_wing::aero::quasi_steady::{QuasiSteadyParams, QuasiSteadySection};
 use flapssm_wing::aero::{SectionGeometry, SectionKinematics, SectionModel};
-use flapssm_wing::kinematics::{EulerState, WingKinematics, rotation_global_from_wing};
+use flapssm_wing::kinematics::{EulerState, WingKinematics};
 use flapssm_wing::vortex::{StripLdvm, StripLdvmFactory, StripLdvmParams};
 
 /// Runs the L2 blade element (`n_strips` strips) over `states` sampled every `dt`.
@@ -755,8 +755,7 @@ fn l2_hover_coefficients() -> (Vec<f64>, (f64, f64), (f64, f64)) {
     for cyc in 0..cycles {
         let (mut lift, mut phi_dot2) = (0.0, 0.0);
         for i in cyc * PER_CYCLE..(cyc + 1) * PER_CYCLE {
-            let r = rotation_global_from_wing(&states[i].angles_rad);
-            lift += r[1][0] * y[i][0] + r[1][1] * y[i][1];
+            lift += lift_n(&states[i], &y[i]);
             phi_dot2 += states[i].rates_rad_s[0].powi(2);
             if cyc == 0 {
                 continue;

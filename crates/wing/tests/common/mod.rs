@@ -2,7 +2,7 @@
 #![allow(dead_code)]
 
 use flapssm_wing::aero::blade_element::BladeGeometry;
-use flapssm_wing::kinematics::EulerState;
+use flapssm_wing::kinematics::{EulerState, rotation_global_from_wing};
 use std::f64::consts::{FRAC_PI_4, PI};
 
 /// The dataset plate: 0.18 × 0.06 m, r0 = 0.055 m, pitch axis 15 %, oil, sensor at the root.
@@ -15,6 +15,13 @@ pub fn blade() -> BladeGeometry {
         density_kg_m3: 800.0,
         sensor_radius_m: 0.055,
     }
+}
+
+/// Lift (N): the vertical (global y₀, up) component of the wing-frame force [F_x, F_y] of the
+/// loads `y` at `state`.
+pub fn lift_n(state: &EulerState, y: &[f64; 5]) -> f64 {
+    let r = rotation_global_from_wing(&state.angles_rad);
+    r[1][0] * y[0] + r[1][1] * y[1]
 }
 
 /// Robofly-like hovering at `f` Hz: φ = 80° sin(2πft), ψ = 0, α = ∓45° at mid-stroke with a
