@@ -608,8 +608,8 @@ fn invalid_l2_settings_are_refused_by_name() {
 }
 
 /// Raw noise-free loads of trajectories `indices` of the default generator (seed 1, 548
-/// trajectories), all run in order on one reused wing.
-fn raw_loads_on_one_wing(fidelity: Fidelity, indices: &[usize]) -> Vec<Vec<[f64; 5]>> {
+/// trajectories), all run in order on one reused wing `cfg`.
+fn raw_loads_on_one_wing(cfg: &VirtualWingConfig, indices: &[usize]) -> Vec<Vec<[f64; 5]>> {
     use flapssm_wing::trajectories::{GeneratorConfig, default_n_train};
     let gen_cfg = GeneratorConfig {
         n_trajectories: 548,
@@ -619,11 +619,7 @@ fn raw_loads_on_one_wing(fidelity: Fidelity, indices: &[usize]) -> Vec<Vec<[f64;
     };
     let specs = gen_cfg.generate().unwrap();
     let dt = gen_cfg.sampling.raw_dt_s();
-    let mut wing = VirtualWing::new(&VirtualWingConfig {
-        fidelity,
-        ..Default::default()
-    })
-    .unwrap();
+    let mut wing = VirtualWing::new(cfg).unwrap();
     let mut states = vec![EulerState::default(); gen_cfg.sampling.n_raw()];
     indices
         .iter()
@@ -642,8 +638,12 @@ fn raw_loads_on_one_wing(fidelity: Fidelity, indices: &[usize]) -> Vec<Vec<[f64;
 #[test]
 fn loads_do_not_depend_on_the_previous_trajectory() {
     for fidelity in [Fidelity::L0, Fidelity::L1, Fidelity::L2] {
-        let fresh = raw_loads_on_one_wing(fidelity, &[194]);
-        let reused = raw_loads_on_one_wing(fidelity, &[193, 194]);
+        let cfg = VirtualWingConfig {
+            fidelity,
+            ..Default::default()
+        };
+        let fresh = raw_loads_on_one_wing(&cfg, &[194]);
+        let reused = raw_loads_on_one_wing(&cfg, &[193, 194]);
         assert!(
             fresh[0] == reused[1],
             "{fidelity:?}: trajectory 194 differs after trajectory 193"
@@ -651,21 +651,57 @@ fn loads_do_not_depend_on_the_previous_trajectory() {
     }
 }
 
+/// Largest |F_x|, |F_y| (N) of each run.
+fn peak_force_n(runs: &[Vec<[f64; 5]>]) -> Vec<f64> {
+    runs.iter()
+        .map(|run| {
+            run.iter()
+                .flat_map(|y| [y[0].abs(), y[1].abs()])
+                .fold(0.0, f64::max)
+        })
+        .collect()
+}
+
 /// Default-generator trajectories on which L2 blew up (|F| of 10⁵ N from a strong wake vortex
 /// met at the leading edge, before the LEV sign check and the viscous core growth) stay bounded:
 /// the noise-free L0 loads of the generator peak at a few newtons.
 #[test]
 fn l2_stays_bounded_where_it_once_blew_up() {
-    let runs = raw_loads_on_one_wing(Fidelity::L2, &[475, 133, 434]);
-    for (run, i) in runs.iter().zip([475, 133, 434]) {
-        let peak = run
-            .iter()
-            .flat_map(|y| [y[0].abs(), y[1].abs()])
-            .fold(0.0, f64::max);
+    let cfg = VirtualWingConfig {
+        fidelity: Fidelity::L2,
+        ..Default::default()
+    };
+    let indices = [475, 133, 434];
+    let peaks = peak_force_n(&raw_loads_on_one_wing(&cfg, &indices));
+    for (peak, i) in peaks.into_iter().zip(indices) {
         println!("trajectory {i}: max |F| {peak:.2} N");
         assert!(
             peak.is_finite() && peak < 15.0,
             "trajectory {i}: max |F| {peak} N"
         );
+    }
+}
+
+/// With larger vortex cores (r_c0 = 0.05 c and 0.1 c, inside the plausible range), the LEV
+/// chain of these trajectories drifted round the leading edge to the pressure face; the next
+/// LEVs, placed towards it, raised |LESP| instead of lowering it and ran away (measured before
+/// the side check: max |F| 412, 1247, 1585 N at 0.05 c and 81, 297, 148 N at 0.1 c; 9 and 10
+/// of the first 150 trajectories above 15 N). Now they stay at the default core's few newtons.
+#[test]
+fn l2_lev_chain_stays_on_the_suction_side_with_large_cores() {
+    for (core, indices) in [(0.05, [31, 37, 84]), (0.1, [17, 52, 139])] {
+        let mut cfg = VirtualWingConfig {
+            fidelity: Fidelity::L2,
+            ..Default::default()
+        };
+        cfg.l2.ldvm.core_radius_frac = core;
+        let peaks = peak_force_n(&raw_loads_on_one_wing(&cfg, &indices));
+        for (peak, i) in peaks.into_iter().zip(indices) {
+            println!("r_c0 = {core} c, trajectory {i}: max |F| {peak:.2} N");
+            assert!(
+                peak.is_finite() && peak < 15.0,
+                "r_c0 = {core} c, trajectory {i}: max |F| {peak} N"
+            );
+        }
     }
 }

@@ -306,10 +306,16 @@ impl Ldvm {
         if let Some(crit) = self.p.lesp_crit.filter(|&cr| lesp0.abs() > cr) {
             let v_le = [vx + omega * self.xp * tz, vz - omega * self.xp * tx];
             // continue the feeding sheet (1/3 of the way to the LEV shed the step before) only
-            // while the LE keeps shedding the same sign (Γ_LEV = −sign(LESP)); after a sign
-            // flip that LEV sits on the other side, and a new one placed towards it would have
-            // the wrong side and sign: the 2×2 solve then sheds runaway pairs
-            let continues = |i: usize| self.wake.gamma_m2_s()[i] * lesp0 < 0.0;
+            // while the LE keeps shedding the same sign (Γ_LEV = −sign(LESP)) and that LEV still
+            // lies on the suction side (normal coordinate of the sign of LESP, the side a fresh
+            // LEV takes). After a sign flip, or once the last LEV has drifted round the LE to the
+            // other face, a new one placed towards it would have the wrong side: each such LEV
+            // raises |LESP| instead of lowering it, and the 2×2 solve sheds runaway pairs
+            let continues = |i: usize| {
+                let (x, z) = self.wake.pos(i);
+                let eta = (x - le[0]) * nx + (z - le[1]) * nz;
+                self.wake.gamma_m2_s()[i] * lesp0 < 0.0 && eta * lesp0 > 0.0
+            };
             p_lev = match (self.wake.last_lev, self.last_lev_step) {
                 (Some(i), Some(st)) if st + 1 == self.step && continues(i) => {
                     let (x, z) = self.wake.pos(i);
