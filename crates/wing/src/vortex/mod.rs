@@ -156,7 +156,7 @@ impl Default for MergeParams {
 /// | `core_growth_reynolds` | Some(1000) | Re = U_ref c/ν of the viscous core growth (Lamb–Oseen) |
 /// | `suction_factor` | 1.0 | multiplies the leading-edge suction ρπcB0² |
 /// | `lev_decay_chords` | Some(4.0) | LEV circulation decays as exp(−s/s_d), s = plate travel / c |
-/// | `tev_decay_chords` | Some(40.0) | same for trailing-edge (wake) vortices |
+/// | `tev_decay_chords` | Some(4.0) | same for trailing-edge (wake) vortices |
 /// | `far_field_chords` | Some(12.0) | free vortices farther than this from the pivot are deleted |
 /// | `merge` | Some(default) | Spalart amalgamation, see [`MergeParams`] |
 /// | `max_vortices` | 110 | hard cap on free vortices (storage is allocated once) |
@@ -167,8 +167,13 @@ impl Default for MergeParams {
 ///
 /// Decay is measured in chords travelled by the plate (not seconds), so the method stays
 /// invariant under time scaling. The LEV decay (s_d = 4 chords, ≈ 4 convective times) mimics the
-/// spanwise drainage of LEV vorticity into the tip vortex of a revolving wing; the slow TEV decay
-/// mimics 3-D roll-up of the wake into tip/root vortices, which a 2-D wake lacks.
+/// spanwise drainage of LEV vorticity into the tip vortex of a revolving wing. The TEV decay
+/// (4 chords, about one half-stroke of travel at r_cp for the smallest stroke amplitudes) mimics
+/// what a 2-D wake lacks: the downwash and the roll-up into tip and root vortices carry a
+/// hovering wing's wake away within about a half-stroke, so the wing meets the wake of the last
+/// reversal (wake capture) but not an accumulation of older ones. With a long-lived 2-D wake
+/// (40 chords, the default until round 9 of docs/vortex-method.md) the loads were chaotic: a
+/// 0.1 % change of the core radius moved F_x by 0.4–0.5 σ.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct LdvmParams {
     /// Chord c (m).
@@ -219,7 +224,7 @@ impl Default for LdvmParams {
             core_growth_reynolds: Some(1000.0),
             suction_factor: 1.0,
             lev_decay_chords: Some(4.0),
-            tev_decay_chords: Some(40.0),
+            tev_decay_chords: Some(4.0),
             far_field_chords: Some(12.0),
             merge: Some(MergeParams::default()),
             max_vortices: 110,
