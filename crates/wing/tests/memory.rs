@@ -12,8 +12,9 @@
 //! default wing adds the Dickinson chordwise coefficient C_T* and the chordwise Kirchhoff
 //! added-mass force −m_a ω_z(n + dω_z); with deviation, ω_z = α̇ + φ̇ sin ψ ≠ α̇. Neither is in
 //! the span of the 11 features (F_y and M_x are fit only to ≈ 1.0–1.15), so on the default wing
-//! and generator only the lag target holds; L0 (≈ 0.72) and the ratio (≈ 1.11) are pinned with
-//! a margin as regression guards, not as the issue-3 targets (see docs/virtual-wing.md).
+//! only the lag target holds, on the default generator (L2: lag 0.249 cycle, ratio 1.00) and on
+//! L1 (lag 0.157, ratio 1.11). L0 (≈ 0.72) and the ratios are pinned with a margin as regression
+//! guards, not as the issue-3 targets (see docs/virtual-wing.md).
 
 use faer::Mat;
 use faer::linalg::solvers::Solve;
@@ -34,6 +35,9 @@ const SEED: u64 = 2021;
 const L0_PIN: f64 = 0.8;
 /// L1 quasi-steady / history ratio there: measured 1.11, pinned with a margin.
 const RATIO_PIN: f64 = 1.05;
+/// The same on L2, the default generator: measured 1.00 (the history model, linear in one
+/// cycle of past inputs, does not capture the vortex method's nonlinear memory).
+const RATIO_PIN_L2: f64 = 0.95;
 /// Past samples seen by the history model (25 Hz): covers one cycle for f ≥ 0.25 Hz.
 const LAGS: [usize; 20] = [
     0, 1, 2, 3, 4, 6, 8, 10, 13, 16, 20, 25, 30, 36, 43, 50, 60, 70, 85, 100,
@@ -299,12 +303,25 @@ fn flat_stroke_plane_meets_the_memory_targets() {
     assert!((0.1..=0.3).contains(&lag), "median lag {lag} cycle");
 }
 
-/// The default wing and generator: the lag target holds; the quasi-steady fit of L0 and the
+/// The default wing and generator (L2, measured: L0 QS 0.718, L2 QS 0.408, history model
+/// 0.407, lag 0.249 cycle): the lag target holds; the quasi-steady fit of L0 and the ratio are
+/// pinned at their measured values with a margin (see the module docs).
+#[test]
+fn default_generator_memory_evidence() {
+    let m = memory(false, Chordwise::Full, Fidelity::L2);
+    let lag = m.median_lag_cycles;
+    assert!((0.1..=0.3).contains(&lag), "median lag {lag} cycle");
+    assert!(m.qs_l0 < L0_PIN, "L0 QS test RMSE {}", m.qs_l0);
+    let ratio = m.qs_unsteady / m.history_unsteady;
+    assert!(ratio > RATIO_PIN_L2, "ratio {ratio}");
+}
+
+/// The default wing on L1 data: the lag target holds; the quasi-steady fit of L0 and the
 /// ratio are pinned at their measured values with a margin (see the module docs) — they fall
 /// short of the targets (< 0.1, ≥ 2) because the chordwise loads and ω_z ≠ α̇ lie outside
 /// the span of the 11 features, quasi-steady or not.
 #[test]
-fn default_trajectories_memory_evidence() {
+fn l1_memory_evidence() {
     let m = memory(false, Chordwise::Full, Fidelity::L1);
     let lag = m.median_lag_cycles;
     assert!((0.1..=0.3).contains(&lag), "median lag {lag} cycle");
@@ -346,12 +363,12 @@ fn default_trajectories_move_leading_edge_first() {
     assert!(share < 0.09, "TE-first share {share}");
 }
 
-/// The memory figures on L2 (strip vortex) data, for the record (docs/vortex-method.md): the
-/// default wing and generator, and the normal-force wing on a flat stroke plane. A study, not a
-/// check: `cargo test --release -p flapssm-wing --test memory -- --ignored --nocapture`.
+/// The memory figures of the normal-force wing on a flat stroke plane with L2 (strip vortex)
+/// data, for the record (docs/vortex-method.md; the default wing's are printed by
+/// `default_generator_memory_evidence`). A study, not a check:
+/// `cargo test --release -p flapssm-wing --test memory -- --ignored --nocapture`.
 #[test]
-#[ignore = "study: prints the L2 memory figures (≈ 20 s)"]
+#[ignore = "study: prints the L2 memory figures of the flat normal-force wing (≈ 10 s)"]
 fn study_l2_memory_evidence() {
-    memory(false, Chordwise::Full, Fidelity::L2);
     memory(true, Chordwise::FrictionOnly, Fidelity::L2);
 }

@@ -39,7 +39,7 @@ pub struct DemoArgs {
     #[arg(long)]
     particles: Option<usize>,
     /// Override the virtual wing's aerodynamic fidelity: l0 (quasi-steady), l1 (unsteady
-    /// low-order, the default generator), l2 (vortex strips).
+    /// low-order, the demo's default), l2 (vortex strips, the default of `simulate`).
     #[arg(long, value_name = "LEVEL")]
     fidelity: Option<String>,
 }

@@ -20,7 +20,7 @@ pub struct SimulateArgs {
     #[arg(long, value_name = "S", default_value_t = 0)]
     seed: u64,
     /// Aerodynamic fidelity: l0 (quasi-steady), l1 (unsteady low-order), l2 (vortex strips).
-    #[arg(long, value_name = "LEVEL", default_value = "l1")]
+    #[arg(long, value_name = "LEVEL", default_value = "l2")]
     fidelity: String,
     /// Output dataset file (.npz).
     #[arg(long, value_name = "FILE")]
