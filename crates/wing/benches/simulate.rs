@@ -1,5 +1,7 @@
-//! Virtual-wing throughput: one trajectory (4700 raw samples at 250 Hz, 8 strips, sensor chain
-//! on) per iteration, at L0 and L1. Multiply by 548 / cores for a dataset.
+//! Virtual-wing throughput: one trajectory (4700 raw samples at 250 Hz, sensor chain on) per
+//! iteration, at L0 and L1 (8 strips) and L2 (2 vortex strips, the default generator). Multiply
+//! by 548 / cores for a dataset (trajectories differ in length of travel, so L2's mean over the
+//! default set differs from this one figure-eight).
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use flapssm_wing::sensor::DatasetSensorErrors;
@@ -14,7 +16,8 @@ fn bench_simulate(c: &mut Criterion) {
         .generate_one(0, Family::FigureEight)
         .expect("trajectory");
     let mut group = c.benchmark_group("simulate_trajectory");
-    for fidelity in [Fidelity::L0, Fidelity::L1] {
+    group.sample_size(10);
+    for fidelity in [Fidelity::L0, Fidelity::L1, Fidelity::L2] {
         let cfg = VirtualWingConfig {
             fidelity,
             ..VirtualWingConfig::default()
