@@ -311,14 +311,16 @@ impl Ldvm {
             // LEV takes). After a sign flip, or once the last LEV has drifted round the LE to the
             // other face, a new one placed towards it would have the wrong side: each such LEV
             // raises |LESP| instead of lowering it, and the 2×2 solve sheds runaway pairs
-            let continues = |i: usize| {
-                let (x, z) = self.wake.pos(i);
-                let eta = (x - le[0]) * nx + (z - le[1]) * nz;
-                self.wake.gamma_m2_s()[i] * lesp0 < 0.0 && eta * lesp0 > 0.0
+            let previous = match (self.wake.last_lev, self.last_lev_step) {
+                (Some(i), Some(st)) if st + 1 == self.step => {
+                    Some((self.wake.pos(i), self.wake.gamma_m2_s()[i]))
+                }
+                _ => None,
             };
-            p_lev = match (self.wake.last_lev, self.last_lev_step) {
-                (Some(i), Some(st)) if st + 1 == self.step && continues(i) => {
-                    let (x, z) = self.wake.pos(i);
+            p_lev = match previous {
+                Some(((x, z), g))
+                    if g * lesp0 < 0.0 && ((x - le[0]) * nx + (z - le[1]) * nz) * lesp0 > 0.0 =>
+                {
                     [le[0] + (x - le[0]) / 3.0, le[1] + (z - le[1]) / 3.0]
                 }
                 _ => {
