@@ -538,29 +538,41 @@ fn default_strip_count_is_converged() {
     }
 }
 
+/// `simulate_dataset` of `n` default-generator trajectories (the first `n_train` for training,
+/// seed `seed`) on `wing` with every sensor effect off.
+fn noise_free_dataset(
+    mut wing: VirtualWingConfig,
+    n: usize,
+    n_train: usize,
+    seed: u64,
+) -> flapssm_data::Dataset {
+    use flapssm_wing::sensor::SensorConfig;
+    use flapssm_wing::trajectories::GeneratorConfig;
+    use flapssm_wing::virtual_wing::{SimulationConfig, simulate_dataset};
+    wing.sensor = SensorConfig::noise_free();
+    let cfg = SimulationConfig {
+        wing,
+        trajectories: GeneratorConfig {
+            n_trajectories: n,
+            n_train,
+            seed,
+            ..Default::default()
+        },
+    };
+    simulate_dataset(&cfg, &|| {}).unwrap()
+}
+
 /// `simulate` at L2 (strip LDVM, 2 strips): every load finite on random trajectories of the
 /// default generator, and the same size as L0 (least-squares slope of L2 on L0 F_x; measured
 /// on these 3 trajectories: slope 0.87, uncentred correlation 0.97; L1 is about half of L0).
 #[test]
 fn l2_dataset_is_finite_and_sized_like_l0() {
-    use flapssm_wing::sensor::SensorConfig;
-    use flapssm_wing::trajectories::GeneratorConfig;
-    use flapssm_wing::virtual_wing::{SimulationConfig, simulate_dataset};
     let run = |fidelity| {
-        let cfg = SimulationConfig {
-            wing: VirtualWingConfig {
-                fidelity,
-                sensor: SensorConfig::noise_free(),
-                ..Default::default()
-            },
-            trajectories: GeneratorConfig {
-                n_trajectories: 3,
-                n_train: 2,
-                seed: 1,
-                ..Default::default()
-            },
+        let wing = VirtualWingConfig {
+            fidelity,
+            ..Default::default()
         };
-        let ds = simulate_dataset(&cfg, &|| {}).unwrap();
+        let ds = noise_free_dataset(wing, 3, 2, 1);
         assert_eq!(
             ds.meta.settings["fidelity"] == "l2",
             fidelity == Fidelity::L2,
@@ -709,25 +721,12 @@ fn l2_lev_chain_stays_on_the_suction_side_with_large_cores() {
 /// Noise-free L2 outputs [F_x … M_z] of 24 default-generator trajectories (seed 2021) from
 /// sample 100 on, with the vortex core r_c0 scaled by `core_scale`.
 fn l2_outputs_from_sample_100(core_scale: f64) -> Vec<[f64; 5]> {
-    use flapssm_wing::sensor::SensorConfig;
-    use flapssm_wing::trajectories::GeneratorConfig;
-    use flapssm_wing::virtual_wing::{SimulationConfig, simulate_dataset};
     let mut wing = VirtualWingConfig {
         fidelity: Fidelity::L2,
-        sensor: SensorConfig::noise_free(),
         ..Default::default()
     };
     wing.l2.ldvm.core_radius_frac *= core_scale;
-    let cfg = SimulationConfig {
-        wing,
-        trajectories: GeneratorConfig {
-            n_trajectories: 24,
-            n_train: 20,
-            seed: 2021,
-            ..Default::default()
-        },
-    };
-    let ds = simulate_dataset(&cfg, &|| {}).unwrap();
+    let ds = noise_free_dataset(wing, 24, 20, 2021);
     ds.trajectories
         .iter()
         .flat_map(|t| t.outputs.as_ref().unwrap()[100..].to_vec())
