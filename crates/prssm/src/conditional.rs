@@ -12,11 +12,14 @@
 //!           = σ_f² − Σ_m H_{mn} W_{mn} + ‖L_dᵀ W_{:n}‖²            (full S = L_d L_dᵀ)
 //! ```
 //! with `H = K` (unwhitened: `Σ K⊙W = kᵀ(K_mm)⁻¹k`) or `H = W` (whitened: `Σ W² = ‖L⁻¹k‖²`).
-//! Cost per batch: `O(M D N)` kernel and one `M × M × N` product; the reverse mode needs two
-//! more (`K̄ = Gᵀ W̄`, `Ḡ += W̄ Kᵀ`). `Ḡ` is mapped to `K̄_mm` once per evaluation
-//! (`Posterior::kmm_grad`).
+//! Cost per batch: `O(M D N)` kernel and one `(M + D_x) × M × N` product `[W; μ] = [G; mᵀG] K`;
+//! the reverse mode needs two more. With `W̄ = m μ̄ + P` (`P` the variance terms), both use the
+//! stacked adjoint `[P; μ̄]` (`(M + D_x) × N`): `K̄ = [G; mᵀG]ᵀ [P; μ̄]` and
+//! `[Ḡ_P; B] += [P; μ̄] Kᵀ`, so the mean needs no product of its own. Once per evaluation,
+//! `m̄ᵀ = B Gᵀ` and `Ḡ = Ḡ_P + m B` ([`ConditionalGrads::mean_terms`]), and `Ḡ` is mapped to
+//! `K̄_mm` ([`Posterior::kmm_grad`]).
 
-use faer::Accum;
+use faer::{Accum, MatRef};
 
 use crate::kernel::{self, KernelKind};
 use crate::linalg::{
@@ -43,8 +46,9 @@ pub struct Posterior {
     pub(crate) kmm_kd: Vec<f64>,
     /// Lower Cholesky factor of `K_mm + jitter·I`.
     pub(crate) l: Vec<f64>,
-    /// `G`: `(K_mm + jitter·I)⁻¹` (unwhitened) or `L⁻¹` (whitened), `M × M`.
-    pub(crate) g: Vec<f64>,
+    /// `[G; mᵀG]`, column-major `(M + D_x) × M`, with `G = (K_mm + jitter·I)⁻¹` (unwhitened)
+    /// or `L⁻¹` (whitened). [`Self::g`] is its top `M × M` block.
+    pub(crate) g_mean: Vec<f64>,
     /// `q(u)` means: row-major `M × D_x` = column-major `D_x × M`.
     pub(crate) q_mean: Vec<f64>,
     /// Diagonal: row-major `M × D_x`; full: `D_x` column-major `M × M` factors.
@@ -106,24 +110,54 @@ impl Posterior {
             }
             p
         };
+        let dx = config.n_state;
+        let mut mg = vec![0.0; dx * m];
+        gemm(
+            view_mut(&mut mg, dx, m),
+            Accum::Replace,
+            view(&params.q_mean, dx, m),
+            view(&g, m, m),
+            1.0,
+        );
+        let mut g_mean = vec![0.0; (m + dx) * m];
+        for ((col, gc), mc) in g_mean
+            .chunks_exact_mut(m + dx)
+            .zip(g.chunks_exact(m))
+            .zip(mg.chunks_exact(dx))
+        {
+            col[..m].copy_from_slice(gc);
+            col[m..].copy_from_slice(mc);
+        }
         Ok(Self {
             kind: config.kernel,
             variance: params.kernel_variance,
             tau_jitter: config.matern_tau_jitter,
             m,
             d,
-            dx: config.n_state,
+            dx,
             inv_len,
             zt,
             kmm,
             kmm_kd,
             l,
-            g,
+            g_mean,
             q_mean: params.q_mean.clone(),
             q_cov: params.q_cov.clone(),
             cov: config.covariance,
             whitened,
         })
+    }
+
+    /// `G` (`M × M`), a view into [`Self::g_mean`].
+    #[inline]
+    pub(crate) fn g(&self) -> MatRef<'_, f64> {
+        view(&self.g_mean, self.m + self.dx, self.m).subrows(0, self.m)
+    }
+
+    /// `[G; mᵀG]` (`(M + D_x) × M`).
+    #[inline]
+    pub(crate) fn g_mean(&self) -> MatRef<'_, f64> {
+        view(&self.g_mean, self.m + self.dx, self.m)
     }
 
     /// The lower Cholesky factor of `K_mm + jitter·I` (column-major `M × M`).
@@ -143,7 +177,7 @@ impl Posterior {
             for j in 0..m {
                 gbar[j * m..j * m + j].fill(0.0);
             }
-            let gt = view(&self.g, m, m).transpose();
+            let gt = self.g().transpose();
             gemm(
                 view_mut(&mut t, m, m),
                 Accum::Replace,
@@ -160,7 +194,7 @@ impl Posterior {
             );
             cholesky_backward(&self.l, &mut out, m)
         } else {
-            let g = view(&self.g, m, m);
+            let g = self.g();
             gemm(
                 view_mut(&mut t, m, m),
                 Accum::Replace,
@@ -180,30 +214,31 @@ impl Posterior {
     }
 }
 
-/// Per-step values kept for the reverse mode: the scaled inputs `X̃` (`D × N`), `K`, `σ_f² g'`
-/// and `W` (`M × N` each), stored in one slice of [`tape_len`] values.
+/// Per-step values kept for the reverse mode: the scaled inputs `X̃` (`D × N`), `K` and
+/// `σ_f² g'` (`M × N` each) and `[W; μ]` (`(M + D_x) × N`), stored in one slice of
+/// [`tape_len`] values.
 struct Tape<'a> {
     xs: &'a mut [f64],
     k: &'a mut [f64],
     kd: &'a mut [f64],
-    w: &'a mut [f64],
+    wm: &'a mut [f64],
 }
 
 /// Values per step stored for the reverse mode of a batch of `capacity` points.
 pub fn tape_len(post: &Posterior, capacity: usize) -> usize {
-    (post.d + 3 * post.m) * capacity
+    (post.d + 3 * post.m + post.dx) * capacity
 }
 
 fn split_tape<'a>(post: &Posterior, cap: usize, n: usize, tape: &'a mut [f64]) -> Tape<'a> {
-    let (d, m) = (post.d, post.m);
+    let (d, m, r) = (post.d, post.m, post.m + post.dx);
     let (xs, rest) = tape.split_at_mut(d * cap);
     let (k, rest) = rest.split_at_mut(m * cap);
-    let (kd, w) = rest.split_at_mut(m * cap);
+    let (kd, wm) = rest.split_at_mut(m * cap);
     Tape {
         xs: &mut xs[..d * n],
         k: &mut k[..m * n],
         kd: &mut kd[..m * n],
-        w: &mut w[..m * n],
+        wm: &mut wm[..r * n],
     }
 }
 
@@ -237,11 +272,10 @@ pub struct ConditionalGrads {
     pub(crate) len_acc: Vec<f64>,
     /// `∂/∂σ_f²`.
     pub(crate) variance: f64,
-    /// `∂/∂m`, row-major `M × D_x`.
-    pub(crate) q_mean: Vec<f64>,
     /// `∂/∂S` or `∂/∂L_d` (layout of [`Params::q_cov`]).
     pub(crate) q_cov: Vec<f64>,
-    /// `∂/∂G` (`M × M`, see [`Posterior::kmm_grad`]).
+    /// `[Ḡ_P; B] = Σ [P; μ̄] Kᵀ`, column-major `(M + D_x) × M` (module doc;
+    /// [`Self::mean_terms`] splits it).
     pub(crate) gbar: Vec<f64>,
 }
 
@@ -252,10 +286,31 @@ impl ConditionalGrads {
             zbar_t: vec![0.0; post.d * post.m],
             len_acc: vec![0.0; post.d],
             variance: 0.0,
-            q_mean: vec![0.0; post.m * post.dx],
             q_cov: vec![0.0; post.q_cov.len()],
-            gbar: vec![0.0; post.m * post.m],
+            gbar: vec![0.0; (post.m + post.dx) * post.m],
         }
+    }
+
+    /// The mean's share of the adjoints, from `B = Σ μ̄ Kᵀ` (`D_x × M`, the bottom rows of
+    /// [`Self::gbar`]): `∂/∂m` (row-major `M × D_x`) `= (B Gᵀ)ᵀ`, since `μ = mᵀG K`, and the
+    /// whole `Ḡ = Ḡ_P + m B` (`M × M`, for [`Posterior::kmm_grad`]).
+    pub(crate) fn mean_terms(&self, post: &Posterior) -> (Vec<f64>, Vec<f64>) {
+        let (m, dx) = (post.m, post.dx);
+        let stacked = view(&self.gbar, m + dx, m);
+        let b = stacked.subrows(m, dx);
+        let mut q_mean = vec![0.0; dx * m];
+        gemm(
+            view_mut(&mut q_mean, dx, m),
+            Accum::Replace,
+            b,
+            post.g().transpose(),
+            1.0,
+        );
+        let mut gbar = vec![0.0; m * m];
+        let mut g = view_mut(&mut gbar, m, m);
+        g.copy_from(stacked.subrows(0, m));
+        gemm(g, Accum::Add, view(&post.q_mean, dx, m).transpose(), b, 1.0);
+        (q_mean, gbar)
     }
 
     /// `self += other`.
@@ -266,7 +321,6 @@ impl ConditionalGrads {
         acc(&mut self.zbar_t, &o.zbar_t);
         acc(&mut self.len_acc, &o.len_acc);
         self.variance += o.variance;
-        acc(&mut self.q_mean, &o.q_mean);
         acc(&mut self.q_cov, &o.q_cov);
         acc(&mut self.gbar, &o.gbar);
     }
@@ -281,7 +335,7 @@ impl ConditionalWorkspace {
             input: vec![0.0; d * n],
             tape: vec![0.0; tape_len(post, n)],
             w2: vec![0.0; m * n],
-            wbar: vec![0.0; m * n],
+            wbar: vec![0.0; (m + dx) * n],
             kbar: vec![0.0; m * n],
             base_bar: vec![0.0; n],
             cx: vec![0.0; m * d],
@@ -331,23 +385,23 @@ impl ConditionalWorkspace {
             t.kd,
             &mut self.rowsum,
         );
+        let r = m + dx;
         gemm(
-            view_mut(t.w, m, n),
+            view_mut(t.wm, r, n),
             Accum::Replace,
-            view(&post.g, m, m),
+            post.g_mean(),
             view(t.k, m, n),
             1.0,
         );
-        let w = &*t.w;
-        gemm(
-            view_mut(&mut self.mean, dx, n),
-            Accum::Replace,
-            view(&post.q_mean, dx, m),
-            view(w, m, n),
-            1.0,
-        );
+        let wm = &*t.wm;
+        for (mean, col) in self.mean[..dx * n]
+            .chunks_exact_mut(dx)
+            .zip(wm.chunks_exact(r))
+        {
+            mean.copy_from_slice(&col[m..]);
+        }
         let k = if post.whitened { None } else { Some(&*t.k) };
-        write_predictive_variance(post, w, m, k, n, &mut self.w2, &mut self.var);
+        write_predictive_variance(post, wm, r, k, n, &mut self.w2, &mut self.var);
     }
 
     /// Reverse mode of the last [`Self::forward`] on `n` points: given `mean_bar`, `var_bar`
@@ -381,27 +435,19 @@ impl ConditionalWorkspace {
         xbar: &mut [f64],
     ) {
         let (m, dx) = (post.m, post.dx);
+        let r = m + dx;
         let t = split_tape(post, self.cap, n, tape);
-        let (w, k) = (&*t.w, &*t.k);
-        // μ = mᵀ W: m̄ᵀ += μ̄ Wᵀ, W̄ = m μ̄.
-        gemm(
-            view_mut(&mut grads.q_mean, dx, m),
-            Accum::Add,
-            view(mean_bar, dx, n),
-            view(w, m, n).transpose(),
-            1.0,
-        );
-        gemm(
-            view_mut(&mut self.wbar, m, n),
-            Accum::Replace,
-            view(&post.q_mean, dx, m).transpose(),
-            view(mean_bar, dx, n),
-            1.0,
-        );
+        // `wm` holds `[W; μ]` (column stride `r`); `self.wbar` becomes `[P; μ̄]`.
+        let (wm, k) = (&*t.wm, &*t.k);
+        let w_view = view(wm, r, n).subrows(0, m);
+        let wbar = &mut self.wbar[..r * n];
+        for (col, mb) in wbar.chunks_exact_mut(r).zip(mean_bar.chunks_exact(dx)) {
+            col[m..].copy_from_slice(mb);
+        }
         match post.cov {
             CovarianceStructure::Diagonal => {
-                for (w2, &wv) in self.w2[..m * n].iter_mut().zip(w) {
-                    *w2 = wv * wv;
+                for (w2, col) in self.w2[..m * n].chunks_exact_mut(m).zip(wm.chunks_exact(r)) {
+                    w2.iter_mut().zip(&col[..m]).for_each(|(a, &b)| *a = b * b);
                 }
                 gemm(
                     view_mut(&mut grads.q_cov, dx, m),
@@ -410,7 +456,7 @@ impl ConditionalWorkspace {
                     view(&self.w2, m, n).transpose(),
                     1.0,
                 );
-                // S̄-weighted W̄ term `2 W ⊙ (Sᵀσ̄²)`, added below with the base term.
+                // `Sᵀσ̄²` for the term `2 W ⊙ (Sᵀσ̄²)` of `P`, written below with the base term.
                 gemm(
                     view_mut(&mut self.kbar, m, n),
                     Accum::Replace,
@@ -420,13 +466,16 @@ impl ConditionalWorkspace {
                 );
             }
             CovarianceStructure::Full => {
+                for col in wbar.chunks_exact_mut(r) {
+                    col[..m].fill(0.0);
+                }
                 for dd in 0..dx {
                     let ld = &post.q_cov[dd * m * m..(dd + 1) * m * m];
                     gemm(
                         view_mut(&mut self.w2, m, n),
                         Accum::Replace,
                         view(ld, m, m).transpose(),
-                        view(w, m, n),
+                        w_view,
                         1.0,
                     );
                     for j in 0..n {
@@ -436,7 +485,7 @@ impl ConditionalWorkspace {
                         }
                     }
                     gemm(
-                        view_mut(&mut self.wbar, m, n),
+                        view_mut(wbar, r, n).subrows_mut(0, m),
                         Accum::Add,
                         view(ld, m, m),
                         view(&self.w2, m, n),
@@ -446,15 +495,15 @@ impl ConditionalWorkspace {
                     gemm(
                         view_mut(gl, m, m),
                         Accum::Add,
-                        view(w, m, n),
+                        w_view,
                         view(&self.w2, m, n).transpose(),
                         1.0,
                     );
                 }
             }
         }
-        // base = σ_f² − Σ H⊙W with β̄ = Σ_d σ̄²_d: whitened (H = W) W̄ −= 2β̄W;
-        // unwhitened (H = K) W̄ −= β̄K and K̄ = −β̄W.
+        // base = σ_f² − Σ H⊙W with β̄ = Σ_d σ̄²_d: whitened (H = W) P −= 2β̄W;
+        // unwhitened (H = K) P −= β̄K and K̄ = −β̄W.
         for (j, vb) in var_bar[..dx * n].chunks_exact(dx).enumerate() {
             let bb: f64 = vb.iter().sum();
             self.base_bar[j] = bb;
@@ -463,51 +512,47 @@ impl ConditionalWorkspace {
         let kbar = &mut self.kbar[..m * n];
         let diagonal = post.cov == CovarianceStructure::Diagonal;
         for (j, &bb) in self.base_bar[..n].iter().enumerate() {
+            let (pc, wc) = (&mut wbar[j * r..j * r + m], &wm[j * r..j * r + m]);
             let cols = j * m..(j + 1) * m;
-            let (wbc, wc, kc, kbc) = (
-                &mut self.wbar[cols.clone()],
-                &w[cols.clone()],
-                &k[cols.clone()],
-                &mut kbar[cols],
-            );
+            let (kc, kbc) = (&k[cols.clone()], &mut kbar[cols]);
             if diagonal && !post.whitened {
-                // One pass: W̄ += 2 W ⊙ (Sᵀσ̄²) − β̄K, K̄ = −β̄W.
-                for (((wb, kb), &wv), &kv) in wbc.iter_mut().zip(kbc.iter_mut()).zip(wc).zip(kc) {
-                    *wb += 2.0 * wv * *kb;
-                    *wb -= bb * kv;
+                // One pass: P = 2 W ⊙ (Sᵀσ̄²) − β̄K, K̄ = −β̄W.
+                for (((p, kb), &wv), &kv) in pc.iter_mut().zip(kbc.iter_mut()).zip(wc).zip(kc) {
+                    *p = 2.0 * wv * *kb;
+                    *p -= bb * kv;
                     *kb = -bb * wv;
                 }
                 continue;
             }
             if diagonal {
-                wbc.iter_mut()
+                pc.iter_mut()
                     .zip(kbc.iter())
                     .zip(wc)
-                    .for_each(|((wb, &s), &wv)| *wb += 2.0 * wv * s);
+                    .for_each(|((p, &s), &wv)| *p = 2.0 * wv * s);
             }
             if post.whitened {
                 let s = -2.0 * bb;
-                wbc.iter_mut().zip(wc).for_each(|(wb, &wv)| *wb += s * wv);
+                pc.iter_mut().zip(wc).for_each(|(p, &wv)| *p += s * wv);
                 kbc.fill(0.0);
             } else {
-                for (((wb, kb), &wv), &kv) in wbc.iter_mut().zip(kbc.iter_mut()).zip(wc).zip(kc) {
-                    *wb -= bb * kv;
+                for (((p, kb), &wv), &kv) in pc.iter_mut().zip(kbc.iter_mut()).zip(wc).zip(kc) {
+                    *p -= bb * kv;
                     *kb = -bb * wv;
                 }
             }
         }
-        // W = G K: K̄ += Gᵀ W̄, Ḡ += W̄ Kᵀ.
+        // [W; μ] = [G; mᵀG] K: K̄ += [G; mᵀG]ᵀ [P; μ̄], [Ḡ_P; B] += [P; μ̄] Kᵀ.
         gemm(
             view_mut(kbar, m, n),
             Accum::Add,
-            view(&post.g, m, m).transpose(),
-            view(&self.wbar, m, n),
+            post.g_mean().transpose(),
+            view(wbar, r, n),
             1.0,
         );
         gemm(
-            view_mut(&mut grads.gbar, m, m),
+            view_mut(&mut grads.gbar, r, m),
             Accum::Add,
-            view(&self.wbar, m, n),
+            view(wbar, r, n),
             view(k, m, n).transpose(),
             1.0,
         );
@@ -564,8 +609,6 @@ fn dot_then_scale(a: &mut [f64], b: &[f64], c: &[f64]) -> f64 {
 pub(crate) struct PredictiveWorkspace {
     cap: usize,
     group: usize,
-    /// `[G; mᵀG]`, column-major `(M + D_x) × M`.
-    g_mean: Vec<f64>,
     /// GP inputs `[x; u]`, column-major `D × N` (filled by the caller).
     pub input: Vec<f64>,
     xs: Vec<f64>,
@@ -583,24 +626,9 @@ impl PredictiveWorkspace {
     /// input part `u` (see [`ConditionalWorkspace::set_input_group`]).
     pub(crate) fn new(post: &Posterior, capacity: usize, group: usize) -> Self {
         let (m, d, dx, n) = (post.m, post.d, post.dx, capacity);
-        let mut mg = vec![0.0; dx * m];
-        gemm(
-            view_mut(&mut mg, dx, m),
-            Accum::Replace,
-            view(&post.q_mean, dx, m),
-            view(&post.g, m, m),
-            1.0,
-        );
-        let mut g_mean = vec![0.0; (m + dx) * m];
-        for j in 0..m {
-            let col = &mut g_mean[j * (m + dx)..(j + 1) * (m + dx)];
-            col[..m].copy_from_slice(&post.g[j * m..(j + 1) * m]);
-            col[m..].copy_from_slice(&mg[j * dx..(j + 1) * dx]);
-        }
         Self {
             cap: n,
             group: group.max(1),
-            g_mean,
             input: vec![0.0; d * n],
             xs: vec![0.0; d * n],
             k: vec![0.0; m * n],
@@ -638,7 +666,7 @@ impl PredictiveWorkspace {
         gemm(
             view_mut(&mut self.wm, r, n),
             Accum::Replace,
-            view(&self.g_mean, r, m),
+            post.g_mean(),
             view(&self.k, m, n),
             1.0,
         );

@@ -504,15 +504,16 @@ impl Elbo {
         g: &mut ParamGrads,
     ) {
         let (m, d) = (post.m, post.d);
+        let (q_mean_bar, mut gbar) = cond.mean_terms(post);
         g.q_mean
             .iter_mut()
-            .zip(cond.q_mean.iter().zip(&kl.q_mean))
+            .zip(q_mean_bar.iter().zip(&kl.q_mean))
             .for_each(|(a, (b, c))| *a += b + c);
         g.q_cov
             .iter_mut()
             .zip(cond.q_cov.iter().zip(&kl.q_cov))
             .for_each(|(a, (b, c))| *a += b + c);
-        let mut kbar = post.kmm_grad(&mut cond.gbar);
+        let mut kbar = post.kmm_grad(&mut gbar);
         if let Some(kk) = &kl.kmm {
             kbar.iter_mut().zip(kk).for_each(|(a, b)| *a += b);
         }
