@@ -6,6 +6,7 @@
 #![warn(missing_docs)]
 
 pub mod aero;
+mod check;
 pub mod cycles;
 pub mod differentiate;
 pub mod features;

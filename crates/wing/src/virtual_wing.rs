@@ -14,6 +14,7 @@
 use crate::aero::blade_element::{AeroError, BladeElement, BladeGeometry};
 use crate::aero::unsteady::UnsteadyParams;
 use crate::aero::{SectionGeometry, SectionModelFactory};
+use crate::check::first_not_positive;
 use crate::cycles::{self, CycleError};
 use crate::kinematics::{EulerState, WingKinematics, rotation_global_from_wing};
 use crate::sensor::{DatasetSensorErrors, SensorConfig, measure};
@@ -188,14 +189,12 @@ impl VirtualWingConfig {
             ("sensor.cutoff_hz", self.sensor.cutoff_hz),
             ("wing.u_ref_radius_m", self.wing.u_ref_radius_m),
         ];
-        for (field, value) in positive {
-            if !(value.is_finite() && value > 0.0) {
-                return Err(SimulateError::InvalidConfig {
-                    field,
-                    value,
-                    reason: "must be finite and > 0",
-                });
-            }
+        if let Some((field, value)) = first_not_positive(&positive) {
+            return Err(SimulateError::InvalidConfig {
+                field,
+                value,
+                reason: "must be finite and > 0",
+            });
         }
         for (field, n) in [("n_strips", self.n_strips), ("l2_strips", self.l2_strips)] {
             if n == 0 || n > 200 {
@@ -487,4 +486,47 @@ pub fn simulate_dataset(
         trajectories,
         n_train: cfg.trajectories.n_train,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Each of the three checks names the field at fault.
+    #[test]
+    fn bad_parameters_are_named() {
+        assert!(VirtualWingConfig::default().check().is_ok());
+        let mut cfg = VirtualWingConfig::default();
+        cfg.sensor.cutoff_hz = f64::NAN;
+        assert!(
+            matches!(
+                cfg.check(),
+                Err(SimulateError::InvalidConfig {
+                    field: "sensor.cutoff_hz",
+                    ..
+                })
+            ),
+            "{:?}",
+            cfg.check()
+        );
+        let mut cfg = VirtualWingConfig::default();
+        cfg.wing.chord_m = -0.1;
+        assert!(matches!(
+            cfg.check(),
+            Err(SimulateError::Aero(AeroError::InvalidParameter {
+                name: "chord_m",
+                value: -0.1,
+                ..
+            }))
+        ));
+        let mut cfg = VirtualWingConfig::default();
+        cfg.l2.max_step_chords = 0.0;
+        assert!(matches!(
+            cfg.check(),
+            Err(SimulateError::InvalidL2(VortexError::InvalidParameter {
+                name: "max_step_chords",
+                ..
+            }))
+        ));
+    }
 }

@@ -11,6 +11,7 @@
 //! M_x = −Σ w_k (r_k − r_s) T_k, M_y = Σ w_k (r_k − r_s) N_k, M_z = Σ w_k M_k (× 1000, N·mm).
 
 use super::{SectionGeometry, SectionKinematics, SectionModel, SectionModelFactory};
+use crate::check::first_not_positive;
 use crate::kinematics::WingKinematics;
 use thiserror::Error;
 
@@ -84,14 +85,12 @@ impl BladeGeometry {
             ("chord_m", self.chord_m),
             ("density_kg_m3", self.density_kg_m3),
         ];
-        for (name, value) in positive {
-            if !(value.is_finite() && value > 0.0) {
-                return Err(AeroError::InvalidParameter {
-                    name,
-                    value,
-                    reason: "must be finite and > 0",
-                });
-            }
+        if let Some((name, value)) = first_not_positive(&positive) {
+            return Err(AeroError::InvalidParameter {
+                name,
+                value,
+                reason: "must be finite and > 0",
+            });
         }
         if !(self.root_offset_m.is_finite() && self.root_offset_m >= 0.0) {
             return Err(AeroError::InvalidParameter {

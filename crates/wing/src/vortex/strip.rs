@@ -58,6 +58,7 @@ use crate::aero::quasi_steady::{QuasiSteadyParams, translational_coefficients};
 use crate::aero::{
     SectionGeometry, SectionKinematics, SectionLoads, SectionModel, SectionModelFactory,
 };
+use crate::check::first_not_positive;
 
 /// Zero-incidence chordwise drag coefficient of the plate at Re = 1000 (dimensionless): the
 /// default L0 model's chordwise coefficient for motion along the chord, with its sign turned,
@@ -101,14 +102,12 @@ impl StripLdvmParams {
             ("max_step_chords", self.max_step_chords),
             ("cn_3d_factor", self.cn_3d_factor),
         ];
-        for (name, value) in positive {
-            if !(value.is_finite() && value > 0.0) {
-                return Err(VortexError::InvalidParameter {
-                    name,
-                    value,
-                    reason: "must be finite and > 0",
-                });
-            }
+        if let Some((name, value)) = first_not_positive(&positive) {
+            return Err(VortexError::InvalidParameter {
+                name,
+                value,
+                reason: "must be finite and > 0",
+            });
         }
         if self.max_substeps == 0 {
             return Err(VortexError::InvalidParameter {
