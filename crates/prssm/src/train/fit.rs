@@ -359,9 +359,9 @@ pub fn fit(
         }
         let p = Params::from_unconstrained(cfg, &flat[..n_e]).map_err(|e| e.to_string())?;
         let initial = initial_of(flat);
-        let (mut s2, mut n) = (0.0, 0.0);
-        for (i, seq) in set.iter().enumerate() {
-            let pred = predict_standardized(
+        // The rollouts in parallel (each has its own seed), the sum in sequence order.
+        let rollout = |(i, seq): (usize, &Sequence)| {
+            predict_standardized(
                 cfg,
                 &p,
                 &initial,
@@ -369,7 +369,18 @@ pub fn fit(
                 spec.eval_particles,
                 derive_seed(eval_seed, 6, i as u64),
             )
-            .map_err(|e| format!("sequence {i}: {e}"))?;
+            .map_err(|e| format!("sequence {i}: {e}"))
+        };
+        #[cfg(feature = "parallel")]
+        let preds: Vec<Result<Prediction, String>> = {
+            use rayon::prelude::*;
+            set.par_iter().enumerate().map(rollout).collect()
+        };
+        #[cfg(not(feature = "parallel"))]
+        let preds: Vec<Result<Prediction, String>> = set.iter().enumerate().map(rollout).collect();
+        let (mut s2, mut n) = (0.0, 0.0);
+        for (seq, pred) in set.iter().zip(preds) {
+            let pred = pred?;
             let t0 = skip(seq.outputs.len() / dy) * dy;
             for (m, y) in pred.output_mean[t0..].iter().zip(&seq.outputs[t0..]) {
                 s2 += (m - y) * (m - y);
