@@ -179,3 +179,57 @@ fn learns_a_forced_duffing_oscillator_with_calibrated_intervals() {
     assert!(rmse <= 1.5 * noise, "RMSE {rmse} > 1.5 × noise {noise}");
     assert!((0.90..=0.99).contains(&coverage), "coverage {coverage}");
 }
+
+/// The evaluation rollouts run in parallel: the epoch records (training and validation RMSE)
+/// and the fitted parameters are the same bits on one thread and on three.
+#[test]
+fn fit_with_validation_is_independent_of_the_thread_count() {
+    let sys = Duffing::default();
+    let train = sequences(&duffing_dataset(&sys, 4, 80, 0.1, 30));
+    let val = sequences(&duffing_dataset(&sys, 3, 80, 0.1, 31));
+    let mut spec = FitSpec::preset(Preset::Sysid, 1, 1);
+    spec.model.n_state = 2;
+    spec.particles = 8;
+    spec.eval_particles = 8;
+    spec.train.windows = WindowSpec::Windows {
+        len: 20,
+        stride: 10,
+    };
+    spec.train.budget = Budget::Epochs(2);
+    spec.train.seed = 5;
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            let mut records = Vec::new();
+            let mut progress = |e: &TrainEvent<'_>| {
+                if let TrainEvent::Epoch(r) = e {
+                    records.push((r.train_rmse, r.val_rmse));
+                }
+            };
+            let out = fit(
+                &spec,
+                &train,
+                &val,
+                TrainHooks {
+                    progress: Some(&mut progress),
+                    ..TrainHooks::default()
+                },
+                None,
+            )
+            .unwrap();
+            (records, out.last.params.unconstrained(&spec.model))
+        })
+    };
+    let bits = |v: Option<f64>| v.map(f64::to_bits);
+    let (r1, p1) = run(1);
+    let (r3, p3) = run(3);
+    assert_eq!(r1.len(), 2);
+    assert!(r1.iter().all(|(t, v)| t.is_some() && v.is_some()));
+    for ((t1, v1), (t3, v3)) in r1.iter().zip(&r3) {
+        assert_eq!((bits(*t1), bits(*v1)), (bits(*t3), bits(*v3)));
+    }
+    assert!(p1.iter().zip(&p3).all(|(a, b)| a.to_bits() == b.to_bits()));
+}
