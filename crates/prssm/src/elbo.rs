@@ -733,14 +733,14 @@ impl Elbo {
                 let na = active[t + 1];
                 let e = &eps[t * step..];
                 let sd_t = &sds[t * step..];
-                for c in 0..na {
-                    for (dd, vxb) in vx_bar.iter_mut().enumerate() {
-                        let i = c * dx + dd;
-                        mean_bar[i] = xbar[i];
-                        let vb = xbar[i] * e[i] / (2.0 * sd_t[i]);
-                        var_bar[i] = vb;
-                        *vxb += vb;
-                    }
+                let k = dx * na;
+                mean_bar[..k].copy_from_slice(&xbar[..k]);
+                // Elementwise (vectorizes), then the σ_x² adjoint summed in the same order.
+                for (((vb, &xb), &ei), &sd) in var_bar[..k].iter_mut().zip(&xbar).zip(e).zip(sd_t) {
+                    *vb = xb * ei / (2.0 * sd);
+                }
+                for vb in var_bar[..k].chunks_exact(dx) {
+                    vx_bar.iter_mut().zip(vb).for_each(|(a, b)| *a += b);
                 }
                 let slot = (t % seg) * tape_step;
                 ws.backward_tape(
