@@ -684,12 +684,18 @@ impl Elbo {
             let e = &eps[t * step..];
             let xn = &mut next[..step];
             let sd_t = &mut sds[t * step..(t + 1) * step];
-            for c in 0..na {
-                for (dd, v) in vx.iter().enumerate() {
-                    let i = c * dx + dd;
-                    let sd = (ws.var[i] + v + jit).sqrt();
-                    sd_t[i] = sd;
-                    xn[i] = x[i] + ws.mean[i] + sd * e[i];
+            let k = dx * na;
+            let cols = sd_t[..k]
+                .chunks_exact_mut(dx)
+                .zip(xn[..k].chunks_exact_mut(dx))
+                .zip(x[..k].chunks_exact(dx))
+                .zip(ws.var[..k].chunks_exact(dx))
+                .zip(ws.mean[..k].chunks_exact(dx))
+                .zip(e[..k].chunks_exact(dx));
+            for (((((sd, xn), x), var), mean), e) in cols {
+                for dd in 0..dx {
+                    sd[dd] = (var[dd] + vx[dd] + jit).sqrt();
+                    xn[dd] = x[dd] + mean[dd] + sd[dd] * e[dd];
                 }
             }
         };
