@@ -98,12 +98,17 @@ impl StepPredictor {
             self.ws.input[c * d + dx..(c + 1) * d].copy_from_slice(&u[..du]);
         }
         self.ws.forward(&self.post, self.particles);
-        for c in 0..self.particles {
+        let (vx, jit) = (&self.process_noise_var, self.jitter);
+        for (c, ((x, var), e)) in x
+            .chunks_exact_mut(dx)
+            .zip(self.ws.var.chunks_exact(dx))
+            .zip(eps.chunks_exact(dx))
+            .take(self.particles)
+            .enumerate()
+        {
             let mean = self.ws.mean(&self.post, c);
-            for (dd, (&mu, &vx)) in mean.iter().zip(&self.process_noise_var).enumerate() {
-                let i = c * dx + dd;
-                let sd = (self.ws.var[i] + vx + self.jitter).sqrt();
-                x[i] += mu + sd * eps[i];
+            for dd in 0..dx {
+                x[dd] += mean[dd] + (var[dd] + vx[dd] + jit).sqrt() * e[dd];
             }
         }
     }
