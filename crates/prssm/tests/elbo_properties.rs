@@ -1,6 +1,8 @@
 //! Properties of the ELBO estimate: Monte-Carlo convergence to the many-particle value,
 //! determinism for a seed regardless of the thread count, and error handling.
 
+mod common;
+
 use flapssm_prssm::{
     Elbo, ElboOptions, InitialStateMode, LossScaling, ModelConfig, Objective, ObjectiveError,
     ParamInit, Params, Sequence, TrainingData, Window,
@@ -85,11 +87,7 @@ fn mc_estimate_converges_to_many_particle_value() {
 fn same_seed_same_result_regardless_of_threads() {
     let (e, theta, batch) = setup(5);
     let run = |threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
-        pool.install(|| {
+        common::with_threads(threads, || {
             let mut g = vec![0.0; theta.len()];
             let l = e.loss_and_grad(&theta, &batch, 9, &mut g).unwrap();
             (l, g)

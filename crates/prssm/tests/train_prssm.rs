@@ -1,5 +1,8 @@
 //! PR-SSM training end to end: the recognition-model gradient through the engine against
-//! finite differences, and identification of a simulated forced Duffing oscillator.
+//! finite differences, identification of a simulated forced Duffing oscillator, and a fit
+//! with validation that does not depend on the thread count.
+
+mod common;
 
 use flapssm_prssm::Elbo;
 use flapssm_prssm::systems::{Duffing, duffing_dataset};
@@ -198,11 +201,7 @@ fn fit_with_validation_is_independent_of_the_thread_count() {
     spec.train.budget = Budget::Epochs(2);
     spec.train.seed = 5;
     let run = |threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
-        pool.install(|| {
+        common::with_threads(threads, || {
             let mut records = Vec::new();
             let mut progress = |e: &TrainEvent<'_>| {
                 if let TrainEvent::Epoch(r) = e {
