@@ -20,7 +20,11 @@ fn benches(c: &mut Criterion) {
         |b, _| {
             b.iter_custom(|iters| {
                 let secs: f64 = (0..iters)
-                    .map(|_| time_batches(&elbo, black_box(&params), 1, 0).unwrap().0)
+                    .map(|_| {
+                        time_batches(&elbo, black_box(&params), 1, 0)
+                            .unwrap()
+                            .total_s
+                    })
                     .sum();
                 std::time::Duration::from_secs_f64(secs)
             })

@@ -114,10 +114,20 @@ pub fn paper_objective(
     Ok((elbo, params))
 }
 
+/// Timings of [`time_batches`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BatchTimes {
+    /// Seconds of all timed minibatches together.
+    pub total_s: f64,
+    /// Seconds of the fastest one (what the machine can do when nothing else runs on it).
+    pub fastest_s: f64,
+    /// FLOP by [`train_step_flops`] of the transitions computed.
+    pub flop: f64,
+}
+
 /// Times `n_batches` minibatches (batch 16 whole sequences) of `objective` at `params`,
 /// after one untimed minibatch that allocates the objective's reusable buffers (a cost paid
-/// once per run, not per epoch); returns (seconds, FLOP by [`train_step_flops`] of the
-/// transitions computed).
+/// once per run, not per epoch).
 ///
 /// # Errors
 /// The objective's error.
@@ -126,7 +136,7 @@ pub fn time_batches(
     params: &[f64],
     n_batches: usize,
     seed: u64,
-) -> Result<(f64, f64), ObjectiveError> {
+) -> Result<BatchTimes, ObjectiveError> {
     let lens = objective.data().lens().to_vec();
     let plan = BatchPlan::new(&lens, WindowSpec::WholeSequences, 16)
         .map_err(|e| ObjectiveError::Shape(e.to_string()))?;
@@ -138,14 +148,22 @@ pub fn time_batches(
     let mut flop = 0.0;
     plan.batch_into(&order, 0, &mut batch);
     objective.loss_and_grad(params, &batch, derive_seed(seed, 3, 0), &mut grad)?;
-    let t0 = Instant::now();
+    let (mut total_s, mut fastest_s) = (0.0, f64::INFINITY);
     for b in 0..n_batches.min(plan.batches_per_epoch()) {
         plan.batch_into(&order, b, &mut batch);
+        let t0 = Instant::now();
         objective.loss_and_grad(params, &batch, derive_seed(seed, 2, b as u64), &mut grad)?;
+        let s = t0.elapsed().as_secs_f64();
+        total_s += s;
+        fastest_s = fastest_s.min(s);
         let transitions: usize = batch.iter().map(|w| w.len.saturating_sub(1)).sum();
         flop += transitions as f64 * window_step_flops;
     }
-    Ok((t0.elapsed().as_secs_f64(), flop))
+    Ok(BatchTimes {
+        total_s,
+        fastest_s,
+        flop,
+    })
 }
 
 /// A paper-shaped model (fresh parameters) for prediction timings.
@@ -234,5 +252,16 @@ mod tests {
     fn gemm_rate_is_a_finite_positive_rate() {
         let r = gemm_rate_gflops(16, 0.0);
         assert!(r.is_finite() && r > 0.0, "{r}");
+    }
+
+    /// Two minibatches of a small paper-shaped objective: the fastest is one of them, and the
+    /// FLOP count is that of the transitions computed (2 × 16 windows × 9 steps).
+    #[test]
+    fn batch_times_are_consistent() {
+        let (elbo, params) = paper_objective(32, 10, 1).unwrap();
+        let t = time_batches(&elbo, &params, 2, 1).unwrap();
+        assert!(t.fastest_s > 0.0 && 2.0 * t.fastest_s <= t.total_s, "{t:?}");
+        let per_step = train_step_flops(elbo.config(), elbo.options().particles);
+        assert_eq!(t.flop, 2.0 * 16.0 * 9.0 * per_step);
     }
 }
