@@ -663,15 +663,20 @@ fn loads_do_not_depend_on_the_previous_trajectory() {
     }
 }
 
-/// Largest |F_x|, |F_y| (N) of each run.
-fn peak_force_n(runs: &[Vec<[f64; 5]>]) -> Vec<f64> {
-    runs.iter()
-        .map(|run| {
-            run.iter()
-                .flat_map(|y| [y[0].abs(), y[1].abs()])
-                .fold(0.0, f64::max)
-        })
-        .collect()
+/// Asserts that the largest |F_x|, |F_y| of each trajectory's raw loads under `cfg` is finite
+/// and below 15 N (printed with `label` first).
+fn assert_peak_force_below_15_n(cfg: &VirtualWingConfig, indices: &[usize], label: &str) {
+    for (run, i) in raw_loads_on_one_wing(cfg, indices).iter().zip(indices) {
+        let peak = run
+            .iter()
+            .flat_map(|y| [y[0].abs(), y[1].abs()])
+            .fold(0.0, f64::max);
+        println!("{label}trajectory {i}: max |F| {peak:.2} N");
+        assert!(
+            peak.is_finite() && peak < 15.0,
+            "{label}trajectory {i}: max |F| {peak} N"
+        );
+    }
 }
 
 /// Default-generator trajectories on which L2 blew up (|F| of 10⁵ N from a strong wake vortex
@@ -683,15 +688,7 @@ fn l2_stays_bounded_where_it_once_blew_up() {
         fidelity: Fidelity::L2,
         ..Default::default()
     };
-    let indices = [475, 133, 434];
-    let peaks = peak_force_n(&raw_loads_on_one_wing(&cfg, &indices));
-    for (peak, i) in peaks.into_iter().zip(indices) {
-        println!("trajectory {i}: max |F| {peak:.2} N");
-        assert!(
-            peak.is_finite() && peak < 15.0,
-            "trajectory {i}: max |F| {peak} N"
-        );
-    }
+    assert_peak_force_below_15_n(&cfg, &[475, 133, 434], "");
 }
 
 /// With larger vortex cores (r_c0 = 0.05 c and 0.1 c, inside the plausible range), the LEV
@@ -707,14 +704,7 @@ fn l2_lev_chain_stays_on_the_suction_side_with_large_cores() {
             ..Default::default()
         };
         cfg.l2.ldvm.core_radius_frac = core;
-        let peaks = peak_force_n(&raw_loads_on_one_wing(&cfg, &indices));
-        for (peak, i) in peaks.into_iter().zip(indices) {
-            println!("r_c0 = {core} c, trajectory {i}: max |F| {peak:.2} N");
-            assert!(
-                peak.is_finite() && peak < 15.0,
-                "r_c0 = {core} c, trajectory {i}: max |F| {peak} N"
-            );
-        }
+        assert_peak_force_below_15_n(&cfg, &indices, &format!("r_c0 = {core} c, "));
     }
 }
 
