@@ -12,12 +12,24 @@
 //!           = σ_f² − Σ_m H_{mn} W_{mn} + ‖L_dᵀ W_{:n}‖²            (full S = L_d L_dᵀ)
 //! ```
 //! with `H = K` (unwhitened: `Σ K⊙W = kᵀ(K_mm)⁻¹k`) or `H = W` (whitened: `Σ W² = ‖L⁻¹k‖²`).
-//! Cost per batch: `O(M D N)` kernel and one `(M + D_x) × M × N` product `[W; μ] = [G; mᵀG] K`;
-//! the reverse mode needs two more. With `W̄ = m μ̄ + P` (`P` the variance terms), both use the
-//! stacked adjoint `[P; μ̄]` (`(M + D_x) × N`): `K̄ = [G; mᵀG]ᵀ [P; μ̄]` and
-//! `[Ḡ_P; B] += [P; μ̄] Kᵀ`, so the mean needs no product of its own. Once per evaluation,
-//! `m̄ᵀ = B Gᵀ` and `Ḡ = Ḡ_P + m B` ([`ConditionalGrads::mean_terms`]), and `Ḡ` is mapped to
-//! `K̄_mm` ([`Posterior::kmm_grad`]).
+//! Cost per batch: `O(M D N)` kernel and one `(M + D_x) × M × N` product `[W; μ] = [G; mᵀG] K`.
+//!
+//! Reverse mode. With `β̄ = Σ_d σ̄²_d` and `P` the variance terms (`2 W ⊙ (Sᵀσ̄²)` for diagonal
+//! `S`, `Σ_d 2σ̄²_d L_d L_dᵀ W` for full `S`; whitened, also `− 2β̄W`), the adjoint of `W` is
+//! `W̄ = m μ̄ + P` (unwhitened: `− β̄K` more, and `K̄` gets `− β̄W` directly). Then
+//!
+//! ```text
+//! Y = [G; mᵀG]ᵀ [P; μ̄]                            (= Gᵀ(m μ̄ + P))
+//! unwhitened: A = G W̄ = Y − β̄W, K̄ = A − β̄W        (G symmetric and G K = W)
+//! whitened:   A = K̄ = GᵀW̄ = Y
+//! [B; m̄ᵀ] += [A; μ̄] Wᵀ                             (Ḡ = W̄Kᵀ: −G Ḡ G = −A Wᵀ, Gᵀ Ḡ Gᵀ = K̄ Wᵀ)
+//! Σ K̄⊙K = Σ μ̄⊙μ + 2 Σ σ̄²⊙(σ² − σ_f²)              (μ is linear, σ² − σ_f² quadratic in K)
+//! ```
+//!
+//! Once per evaluation `B` (`M × M`) becomes `K̄_mm = −B` (unwhitened) or `L̄ = −tril(B)` and
+//! the Cholesky adjoint (whitened) in [`Posterior::kmm_grad`]. The reverse mode never reads
+//! `K`, so the tape holds `X̃`, `σ_f² g'`, `[W; μ]` and `σ² − σ_f²` but not `K`: a quarter less
+//! memory traffic, which is the largest cost of a step outside the products.
 
 use faer::{Accum, MatRef};
 
@@ -47,10 +59,8 @@ pub struct Posterior {
     /// Lower Cholesky factor of `K_mm + jitter·I`.
     pub(crate) l: Vec<f64>,
     /// `[G; mᵀG]`, column-major `(M + D_x) × M`, with `G = (K_mm + jitter·I)⁻¹` (unwhitened)
-    /// or `L⁻¹` (whitened). [`Self::g`] is its top `M × M` block.
+    /// or `L⁻¹` (whitened).
     pub(crate) g_mean: Vec<f64>,
-    /// `q(u)` means: row-major `M × D_x` = column-major `D_x × M`.
-    pub(crate) q_mean: Vec<f64>,
     /// Diagonal: row-major `M × D_x`; full: `D_x` column-major `M × M` factors.
     pub(crate) q_cov: Vec<f64>,
     pub(crate) cov: CovarianceStructure,
@@ -141,17 +151,10 @@ impl Posterior {
             kmm_kd,
             l,
             g_mean,
-            q_mean: params.q_mean.clone(),
             q_cov: params.q_cov.clone(),
             cov: config.covariance,
             whitened,
         })
-    }
-
-    /// `G` (`M × M`), a view into [`Self::g_mean`].
-    #[inline]
-    pub(crate) fn g(&self) -> MatRef<'_, f64> {
-        view(&self.g_mean, self.m + self.dx, self.m).subrows(0, self.m)
     }
 
     /// `[G; mᵀG]` (`(M + D_x) × M`).
@@ -165,80 +168,45 @@ impl Posterior {
         &self.l
     }
 
-    /// Maps the adjoint `Ḡ` (`M × M`) of the projection `G` to `∂loss/∂K_mm` (`M × M`,
-    /// column-major; every entry treated as independent):
-    /// unwhitened `G = K⁻¹`: `K̄ = −G Ḡ G`; whitened `G = L⁻¹`: `L̄ = −tril(Gᵀ tril(Ḡ) Gᵀ)`,
-    /// then the Cholesky adjoint. `gbar` is overwritten. Cost `O(M³)`.
-    pub(crate) fn kmm_grad(&self, gbar: &mut [f64]) -> Vec<f64> {
-        let m = self.m;
-        let mut t = vec![0.0; m * m];
-        let mut out = vec![0.0; m * m];
+    /// Maps `B = Σ A Wᵀ` (`M × M`, see the module doc) to `∂loss/∂K_mm` (`M × M`,
+    /// column-major; every entry treated as independent): unwhitened `K̄_mm = −B`; whitened
+    /// `L̄ = −tril(B)` (the adjoint of `W = L⁻¹K`), then the Cholesky adjoint. `b` is
+    /// overwritten.
+    pub(crate) fn kmm_grad(&self, b: &mut [f64]) -> Vec<f64> {
+        b.iter_mut().for_each(|v| *v = -*v);
         if self.whitened {
-            for j in 0..m {
-                gbar[j * m..j * m + j].fill(0.0);
-            }
-            let gt = self.g().transpose();
-            gemm(
-                view_mut(&mut t, m, m),
-                Accum::Replace,
-                gt,
-                view(gbar, m, m),
-                1.0,
-            );
-            gemm(
-                view_mut(&mut out, m, m),
-                Accum::Replace,
-                view(&t, m, m),
-                gt,
-                -1.0,
-            );
-            cholesky_backward(&self.l, &mut out, m)
+            cholesky_backward(&self.l, b, self.m)
         } else {
-            let g = self.g();
-            gemm(
-                view_mut(&mut t, m, m),
-                Accum::Replace,
-                g,
-                view(gbar, m, m),
-                1.0,
-            );
-            gemm(
-                view_mut(&mut out, m, m),
-                Accum::Replace,
-                view(&t, m, m),
-                g,
-                -1.0,
-            );
-            out
+            b.to_vec()
         }
     }
 }
 
-/// Per-step values kept for the reverse mode: the scaled inputs `X̃` (`D × N`), `K` and
-/// `σ_f² g'` (`M × N` each) and `[W; μ]` (`(M + D_x) × N`), stored in one slice of
-/// [`tape_len`] values.
+/// Per-step values kept for the reverse mode: the scaled inputs `X̃` (`D × N`),
+/// `σ_f² g'` (`M × N`), `[W; μ]` (`(M + D_x) × N`) and `σ² − σ_f²` (`D_x × N`), stored in one
+/// slice of [`tape_len`] values.
 struct Tape<'a> {
     xs: &'a mut [f64],
-    k: &'a mut [f64],
     kd: &'a mut [f64],
     wm: &'a mut [f64],
+    quad: &'a mut [f64],
 }
 
 /// Values per step stored for the reverse mode of a batch of `capacity` points.
 pub fn tape_len(post: &Posterior, capacity: usize) -> usize {
-    (post.d + 3 * post.m + post.dx) * capacity
+    (post.d + 2 * post.m + 2 * post.dx) * capacity
 }
 
 fn split_tape<'a>(post: &Posterior, cap: usize, n: usize, tape: &'a mut [f64]) -> Tape<'a> {
-    let (d, m, r) = (post.d, post.m, post.m + post.dx);
+    let (d, m, dx, r) = (post.d, post.m, post.dx, post.m + post.dx);
     let (xs, rest) = tape.split_at_mut(d * cap);
-    let (k, rest) = rest.split_at_mut(m * cap);
-    let (kd, wm) = rest.split_at_mut(m * cap);
+    let (kd, rest) = rest.split_at_mut(m * cap);
+    let (wm, quad) = rest.split_at_mut(r * cap);
     Tape {
         xs: &mut xs[..d * n],
-        k: &mut k[..m * n],
         kd: &mut kd[..m * n],
         wm: &mut wm[..r * n],
+        quad: &mut quad[..dx * n],
     }
 }
 
@@ -249,6 +217,8 @@ pub struct ConditionalWorkspace {
     /// GP inputs `[x; u]`, column-major `D × N` (filled by the caller).
     pub input: Vec<f64>,
     tape: Vec<f64>,
+    /// `K` of the current step (`M × N`; not on the tape).
+    k: Vec<f64>,
     w2: Vec<f64>,
     wbar: Vec<f64>,
     kbar: Vec<f64>,
@@ -274,8 +244,8 @@ pub struct ConditionalGrads {
     pub(crate) variance: f64,
     /// `∂/∂S` or `∂/∂L_d` (layout of [`Params::q_cov`]).
     pub(crate) q_cov: Vec<f64>,
-    /// `[Ḡ_P; B] = Σ [P; μ̄] Kᵀ`, column-major `(M + D_x) × M` (module doc;
-    /// [`Self::mean_terms`] splits it).
+    /// `[B; m̄ᵀ] = Σ [A; μ̄] Wᵀ`, column-major `(M + D_x) × M` (module doc;
+    /// [`Self::split_stacked`] splits it).
     pub(crate) gbar: Vec<f64>,
 }
 
@@ -291,26 +261,16 @@ impl ConditionalGrads {
         }
     }
 
-    /// The mean's share of the adjoints, from `B = Σ μ̄ Kᵀ` (`D_x × M`, the bottom rows of
-    /// [`Self::gbar`]): `∂/∂m` (row-major `M × D_x`) `= (B Gᵀ)ᵀ`, since `μ = mᵀG K`, and the
-    /// whole `Ḡ = Ḡ_P + m B` (`M × M`, for [`Posterior::kmm_grad`]).
-    pub(crate) fn mean_terms(&self, post: &Posterior) -> (Vec<f64>, Vec<f64>) {
+    /// Splits [`Self::gbar`] into `∂/∂m` (row-major `M × D_x`, the bottom rows `m̄ᵀ`) and `B`
+    /// (`M × M`, for [`Posterior::kmm_grad`]).
+    pub(crate) fn split_stacked(&self, post: &Posterior) -> (Vec<f64>, Vec<f64>) {
         let (m, dx) = (post.m, post.dx);
         let stacked = view(&self.gbar, m + dx, m);
-        let b = stacked.subrows(m, dx);
         let mut q_mean = vec![0.0; dx * m];
-        gemm(
-            view_mut(&mut q_mean, dx, m),
-            Accum::Replace,
-            b,
-            post.g().transpose(),
-            1.0,
-        );
-        let mut gbar = vec![0.0; m * m];
-        let mut g = view_mut(&mut gbar, m, m);
-        g.copy_from(stacked.subrows(0, m));
-        gemm(g, Accum::Add, view(&post.q_mean, dx, m).transpose(), b, 1.0);
-        (q_mean, gbar)
+        view_mut(&mut q_mean, dx, m).copy_from(stacked.subrows(m, dx));
+        let mut b = vec![0.0; m * m];
+        view_mut(&mut b, m, m).copy_from(stacked.subrows(0, m));
+        (q_mean, b)
     }
 
     /// `self += other`.
@@ -334,6 +294,7 @@ impl ConditionalWorkspace {
             cap: n,
             input: vec![0.0; d * n],
             tape: vec![0.0; tape_len(post, n)],
+            k: vec![0.0; m * n],
             w2: vec![0.0; m * n],
             wbar: vec![0.0; (m + dx) * n],
             kbar: vec![0.0; m * n],
@@ -372,6 +333,7 @@ impl ConditionalWorkspace {
         let (m, d, dx) = (post.m, post.d, post.dx);
         debug_assert!(n <= self.cap);
         let t = split_tape(post, self.cap, n, tape);
+        let k = &mut self.k[..m * n];
         kernel::scale_points(&self.input[..d * n], &post.inv_len, t.xs);
         kernel::cross_cov_grouped(
             post.kind,
@@ -381,7 +343,7 @@ impl ConditionalWorkspace {
             t.xs,
             d,
             (dx, self.input_group.max(1)),
-            t.k,
+            k,
             t.kd,
             &mut self.rowsum,
         );
@@ -390,7 +352,7 @@ impl ConditionalWorkspace {
             view_mut(t.wm, r, n),
             Accum::Replace,
             post.g_mean(),
-            view(t.k, m, n),
+            view(k, m, n),
             1.0,
         );
         let wm = &*t.wm;
@@ -400,8 +362,8 @@ impl ConditionalWorkspace {
         {
             mean.copy_from_slice(&col[m..]);
         }
-        let k = if post.whitened { None } else { Some(&*t.k) };
-        write_predictive_variance(post, wm, r, k, n, &mut self.w2, &mut self.var);
+        let h = if post.whitened { None } else { Some(&*k) };
+        write_predictive_variance(post, wm, r, h, n, &mut self.w2, &mut self.var, Some(t.quad));
     }
 
     /// Reverse mode of the last [`Self::forward`] on `n` points: given `mean_bar`, `var_bar`
@@ -422,7 +384,8 @@ impl ConditionalWorkspace {
         self.tape = tape;
     }
 
-    /// [`Self::backward`] from the intermediates a [`Self::forward_tape`] stored in `tape`.
+    /// [`Self::backward`] from the intermediates a [`Self::forward_tape`] stored in `tape`
+    /// (the formulas of the module doc).
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn backward_tape(
         &mut self,
@@ -437,31 +400,51 @@ impl ConditionalWorkspace {
         let (m, dx) = (post.m, post.dx);
         let r = m + dx;
         let t = split_tape(post, self.cap, n, tape);
-        // `wm` holds `[W; μ]` (column stride `r`); `self.wbar` becomes `[P; μ̄]`.
-        let (wm, k) = (&*t.wm, &*t.k);
+        // `wm` holds `[W; μ]` (column stride `r`); `self.wbar` becomes `[P; μ̄]`, then `[A; μ̄]`.
+        let wm = &*t.wm;
         let w_view = view(wm, r, n).subrows(0, m);
         let wbar = &mut self.wbar[..r * n];
         for (col, mb) in wbar.chunks_exact_mut(r).zip(mean_bar.chunks_exact(dx)) {
             col[m..].copy_from_slice(mb);
         }
+        // β̄ = Σ_d σ̄²_d, the adjoint of the prior term σ_f² − Σ H⊙W.
+        for (j, vb) in var_bar[..dx * n].chunks_exact(dx).enumerate() {
+            let bb: f64 = vb.iter().sum();
+            self.base_bar[j] = bb;
+            grads.variance += bb;
+        }
+        let kbar = &mut self.kbar[..m * n];
+        let whitened = post.whitened;
         match post.cov {
             CovarianceStructure::Diagonal => {
-                for (w2, col) in self.w2[..m * n].chunks_exact_mut(m).zip(wm.chunks_exact(r)) {
-                    w2.iter_mut().zip(&col[..m]).for_each(|(a, &b)| *a = b * b);
+                // `V = Sᵀσ̄²`, then one pass: `W⊙W` and `P = 2 W⊙V` (whitened: `− 2β̄W`).
+                gemm(
+                    view_mut(kbar, m, n),
+                    Accum::Replace,
+                    view(&post.q_cov, dx, m).transpose(),
+                    view(var_bar, dx, n),
+                    1.0,
+                );
+                let cols = self.w2[..m * n]
+                    .chunks_exact_mut(m)
+                    .zip(wbar.chunks_exact_mut(r))
+                    .zip(kbar.chunks_exact(m))
+                    .zip(wm.chunks_exact(r))
+                    .zip(&self.base_bar[..n]);
+                for ((((w2, pc), vc), wc), &bb) in cols {
+                    let (pc, wc) = (&mut pc[..m], &wc[..m]);
+                    let s = if whitened { -2.0 * bb } else { 0.0 };
+                    for (((w2, p), &v), &wv) in w2.iter_mut().zip(pc.iter_mut()).zip(vc).zip(wc) {
+                        *w2 = wv * wv;
+                        *p = 2.0 * wv * v;
+                        *p += s * wv;
+                    }
                 }
                 gemm(
                     view_mut(&mut grads.q_cov, dx, m),
                     Accum::Add,
                     view(var_bar, dx, n),
                     view(&self.w2, m, n).transpose(),
-                    1.0,
-                );
-                // `Sᵀσ̄²` for the term `2 W ⊙ (Sᵀσ̄²)` of `P`, written below with the base term.
-                gemm(
-                    view_mut(&mut self.kbar, m, n),
-                    Accum::Replace,
-                    view(&post.q_cov, dx, m).transpose(),
-                    view(var_bar, dx, n),
                     1.0,
                 );
             }
@@ -500,63 +483,66 @@ impl ConditionalWorkspace {
                         1.0,
                     );
                 }
-            }
-        }
-        // base = σ_f² − Σ H⊙W with β̄ = Σ_d σ̄²_d: whitened (H = W) P −= 2β̄W;
-        // unwhitened (H = K) P −= β̄K and K̄ = −β̄W.
-        for (j, vb) in var_bar[..dx * n].chunks_exact(dx).enumerate() {
-            let bb: f64 = vb.iter().sum();
-            self.base_bar[j] = bb;
-            grads.variance += bb;
-        }
-        let kbar = &mut self.kbar[..m * n];
-        let diagonal = post.cov == CovarianceStructure::Diagonal;
-        for (j, &bb) in self.base_bar[..n].iter().enumerate() {
-            let (pc, wc) = (&mut wbar[j * r..j * r + m], &wm[j * r..j * r + m]);
-            let cols = j * m..(j + 1) * m;
-            let (kc, kbc) = (&k[cols.clone()], &mut kbar[cols]);
-            if diagonal && !post.whitened {
-                // One pass: P = 2 W ⊙ (Sᵀσ̄²) − β̄K, K̄ = −β̄W.
-                for (((p, kb), &wv), &kv) in pc.iter_mut().zip(kbc.iter_mut()).zip(wc).zip(kc) {
-                    *p = 2.0 * wv * *kb;
-                    *p -= bb * kv;
-                    *kb = -bb * wv;
-                }
-                continue;
-            }
-            if diagonal {
-                pc.iter_mut()
-                    .zip(kbc.iter())
-                    .zip(wc)
-                    .for_each(|((p, &s), &wv)| *p = 2.0 * wv * s);
-            }
-            if post.whitened {
-                let s = -2.0 * bb;
-                pc.iter_mut().zip(wc).for_each(|(p, &wv)| *p += s * wv);
-                kbc.fill(0.0);
-            } else {
-                for (((p, kb), &wv), &kv) in pc.iter_mut().zip(kbc.iter_mut()).zip(wc).zip(kc) {
-                    *p -= bb * kv;
-                    *kb = -bb * wv;
+                if whitened {
+                    for ((pc, wc), &bb) in wbar
+                        .chunks_exact_mut(r)
+                        .zip(wm.chunks_exact(r))
+                        .zip(&self.base_bar[..n])
+                    {
+                        let s = -2.0 * bb;
+                        pc[..m]
+                            .iter_mut()
+                            .zip(&wc[..m])
+                            .for_each(|(p, &wv)| *p += s * wv);
+                    }
                 }
             }
         }
-        // [W; μ] = [G; mᵀG] K: K̄ += [G; mᵀG]ᵀ [P; μ̄], [Ḡ_P; B] += [P; μ̄] Kᵀ.
+        // Y = [G; mᵀG]ᵀ [P; μ̄]; then A (into the top rows of `wbar`) and K̄ (into `kbar`).
         gemm(
             view_mut(kbar, m, n),
-            Accum::Add,
+            Accum::Replace,
             post.g_mean().transpose(),
             view(wbar, r, n),
             1.0,
         );
+        let cols = wbar
+            .chunks_exact_mut(r)
+            .zip(kbar.chunks_exact_mut(m))
+            .zip(wm.chunks_exact(r))
+            .zip(&self.base_bar[..n]);
+        for (((ac, kc), wc), &bb) in cols {
+            let (ac, wc) = (&mut ac[..m], &wc[..m]);
+            if whitened {
+                ac.copy_from_slice(kc);
+            } else {
+                for ((a, kb), &wv) in ac.iter_mut().zip(kc.iter_mut()).zip(wc) {
+                    *a = *kb - bb * wv;
+                    *kb = *a - bb * wv;
+                }
+            }
+        }
+        // [B; m̄ᵀ] += [A; μ̄] Wᵀ.
         gemm(
             view_mut(&mut grads.gbar, r, m),
             Accum::Add,
             view(wbar, r, n),
-            view(k, m, n).transpose(),
+            w_view.transpose(),
             1.0,
         );
-        grads.variance += dot_then_scale(kbar, k, t.kd) / post.variance;
+        // ∂/∂σ_f² through K = σ_f² g: Σ K̄⊙K / σ_f², with Σ K̄⊙K = Σ μ̄⊙μ + 2 Σ σ̄²⊙(σ² − σ_f²).
+        let mut euler = 0.0;
+        for (((mb, col), vb), q) in mean_bar
+            .chunks_exact(dx)
+            .zip(wm.chunks_exact(r))
+            .zip(var_bar.chunks_exact(dx))
+            .zip(t.quad.chunks_exact(dx))
+        {
+            euler += dot(mb, &col[m..]) + 2.0 * dot(vb, q);
+        }
+        grads.variance += euler / post.variance;
+        // C = K̄ ⊙ σ_f² g'.
+        kbar.iter_mut().zip(&*t.kd).for_each(|(c, &g)| *c *= g);
         kernel::cross_cov_backward(
             kbar,
             &post.zt,
@@ -571,36 +557,6 @@ impl ConditionalWorkspace {
             &mut self.rowsum,
         );
     }
-}
-
-/// `Σ aᵢbᵢ` (the order of [`dot`]), then `aᵢ ← aᵢ cᵢ`, in one pass.
-#[inline]
-fn dot_then_scale(a: &mut [f64], b: &[f64], c: &[f64]) -> f64 {
-    let mut acc = [0.0; 8];
-    let n8 = a.len() / 8 * 8;
-    let (ah, at) = a.split_at_mut(n8);
-    for ((x, y), z) in ah
-        .chunks_exact_mut(8)
-        .zip(b.chunks_exact(8))
-        .zip(c.chunks_exact(8))
-    {
-        // Whole-array loads and stores, so that the loop vectorizes.
-        let xv: [f64; 8] = (&*x).try_into().expect("chunk of 8");
-        let yv: [f64; 8] = y.try_into().expect("chunk of 8");
-        let zv: [f64; 8] = z.try_into().expect("chunk of 8");
-        let mut out = [0.0; 8];
-        for l in 0..8 {
-            acc[l] = xv[l].mul_add(yv[l], acc[l]);
-            out[l] = xv[l] * zv[l];
-        }
-        x.copy_from_slice(&out);
-    }
-    let mut s = ((acc[0] + acc[4]) + (acc[1] + acc[5])) + ((acc[2] + acc[6]) + (acc[3] + acc[7]));
-    for ((x, y), z) in at.iter_mut().zip(&b[n8..]).zip(&c[n8..]) {
-        s = x.mul_add(*y, s);
-        *x *= z;
-    }
-    s
 }
 
 /// Forward-only conditional for prediction (no derivatives, no tape). `W` and the means come
@@ -675,7 +631,7 @@ impl PredictiveWorkspace {
         } else {
             Some(&self.k[..])
         };
-        write_predictive_variance(post, &self.wm, r, k, n, &mut self.w2, &mut self.var);
+        write_predictive_variance(post, &self.wm, r, k, n, &mut self.w2, &mut self.var, None);
     }
 }
 
@@ -683,7 +639,9 @@ impl PredictiveWorkspace {
 /// `σ²_d(n) = k** − w_nᵀh_n + Σ_i S_d,ii w_in²` (diagonal `S`) or `+ ‖L_dᵀw_n‖²` (full
 /// `S_d = L_dL_dᵀ`), with `w_n` the first `M` entries of column `n` of `w` (column stride
 /// `stride ≥ M`) and `h_n = k_n` (column `n` of `k`, `M × N`) or `w_n` when `k` is `None`
-/// (whitened). `w2` (`M × N`) is scratch. Allocates nothing.
+/// (whitened). With `quad`, also writes `σ²_d(n) − k** = Σ_i … − w_nᵀh_n` there (`D_x × N`).
+/// `w2` (`M × N`) is scratch. Allocates nothing.
+#[allow(clippy::too_many_arguments)]
 fn write_predictive_variance(
     post: &Posterior,
     w: &[f64],
@@ -692,6 +650,7 @@ fn write_predictive_variance(
     n: usize,
     w2: &mut [f64],
     var: &mut [f64],
+    mut quad: Option<&mut [f64]>,
 ) {
     let (m, dx) = (post.m, post.dx);
     let w_view = view(&w[..stride * n], stride, n).subrows(0, m);
@@ -728,7 +687,14 @@ fn write_predictive_variance(
     for (j, v) in var[..dx * n].chunks_exact_mut(dx).enumerate() {
         let wc = &w[j * stride..j * stride + m];
         let hc = k.map_or(wc, |k| &k[j * m..(j + 1) * m]);
-        let base = post.variance - dot(wc, hc);
+        let wh = dot(wc, hc);
+        if let Some(q) = quad.as_deref_mut() {
+            q[j * dx..(j + 1) * dx]
+                .iter_mut()
+                .zip(v.iter())
+                .for_each(|(q, &v)| *q = v - wh);
+        }
+        let base = post.variance - wh;
         v.iter_mut().for_each(|v| *v += base);
     }
 }
