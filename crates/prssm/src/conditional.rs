@@ -433,11 +433,13 @@ impl ConditionalWorkspace {
                     .zip(&self.base_bar[..n]);
                 for ((((w2, pc), vc), wc), &bb) in cols {
                     let (pc, wc) = (&mut pc[..m], &wc[..m]);
-                    let s = if whitened { -2.0 * bb } else { 0.0 };
+                    let s = -2.0 * bb;
                     for (((w2, p), &v), &wv) in w2.iter_mut().zip(pc.iter_mut()).zip(vc).zip(wc) {
                         *w2 = wv * wv;
                         *p = 2.0 * wv * v;
-                        *p += s * wv;
+                        if whitened {
+                            *p += s * wv;
+                        }
                     }
                 }
                 gemm(
