@@ -14,8 +14,9 @@
 //! all `ε ~ N(0, I)` drawn from `ChaCha8Rng::seed_from_u64(seed)` on stream `b` (the batch
 //! position), so results do not depend on the thread count. Windows are processed in fixed
 //! chunks of `windows_per_task`, all particles of a chunk batched per step; chunk results are
-//! reduced in chunk order. The backward pass recomputes each step's conditional from stored
-//! states and draws (memory `O(T · D_x · N)`).
+//! reduced in chunk order. The backward pass reads each step's intermediates from a tape
+//! ([`conditional::tape_len`] values per step); beyond [`TAPE_BUDGET_BYTES`] per chunk, earlier
+//! segments are recomputed from the stored states and draws.
 
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
