@@ -27,7 +27,7 @@
 //! ```
 //!
 //! Once per evaluation `B` (`M × M`) becomes `K̄_mm = −B` (unwhitened) or `L̄ = −tril(B)` and
-//! the Cholesky adjoint (whitened) in [`Posterior::kmm_grad`]. The reverse mode never reads
+//! the Cholesky adjoint (whitened) in `Posterior::kmm_grad`. The reverse mode never reads
 //! `K`, so the tape holds `X̃`, `σ_f² g'`, `[W; μ]` and `σ² − σ_f²` but not `K`: a quarter less
 //! memory traffic, which is the largest cost of a step outside the products.
 
