@@ -28,6 +28,7 @@ use crate::kernel;
 use crate::kl::kl_divergence;
 use crate::objective::{Objective, ObjectiveError, Window};
 use crate::params::{ConfigError, ModelConfig, ParamGrads, Parametrization, Params};
+use crate::tape::TapeMemory;
 
 /// One training sequence in standardized units.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -227,7 +228,7 @@ struct ScratchPool(std::sync::Mutex<Vec<ChunkScratch>>);
 
 #[derive(Debug, Default)]
 struct ChunkScratch {
-    tape: Vec<f64>,
+    tape: TapeMemory,
     xs: Vec<f64>,
     eps: Vec<f64>,
     sds: Vec<f64>,
@@ -667,8 +668,8 @@ impl Elbo {
         let tape_step = conditional::tape_len(post, n);
         let n_steps = t_max.saturating_sub(1);
         let seg = (self.tape_budget_bytes / (8 * tape_step.max(1))).clamp(1, n_steps.max(1));
-        let mut tape = std::mem::take(&mut scratch.tape);
-        tape.resize(seg.min(n_steps) * tape_step, 0.0);
+        let mut tape_memory = std::mem::take(&mut scratch.tape);
+        let tape = tape_memory.reserve(seg.min(n_steps) * tape_step);
         // Standard deviations √(σ² + σ_x² + δ) of every step, `(T − 1) × D_x × N`.
         let mut sds = std::mem::take(&mut scratch.sds);
         sds.resize(n_steps * step, 0.0);
@@ -778,7 +779,7 @@ impl Elbo {
             }
         }
         self.scratch.put(ChunkScratch {
-            tape,
+            tape: tape_memory,
             xs,
             eps,
             sds,

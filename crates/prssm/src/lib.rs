@@ -40,6 +40,7 @@ pub mod predict;
 pub mod published;
 pub mod stream;
 pub mod systems;
+mod tape;
 pub mod train;
 
 pub use elbo::{
