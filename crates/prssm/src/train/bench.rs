@@ -24,8 +24,9 @@ pub const AUTHORS_PREDICT_S: f64 = 0.152;
 
 /// FLOP of one training transition step (forward + backward) of `n_points`
 /// particle-windows, dominant terms: the three `M × M × N` products `W = G K`, `Y = Gᵀ W̄`
-/// and `B += A Wᵀ` (`6 M² N`; see [`crate::conditional`]), the kernel distances and their two adjoint products
-/// (`6 M D N`), the mean and variance products and their adjoints (`12 M D_x N`).
+/// and `B += A Wᵀ` (`6 M² N`; see [`crate::conditional`]), the kernel distances and their two
+/// adjoint products (`6 M D N`), the mean and variance products and their adjoints
+/// (`12 M D_x N`).
 /// Paper configuration (`M` 100, `D` 19, `D_x` 12), `N = 480`: 41 MFLOP.
 pub fn train_step_flops(config: &ModelConfig, n_points: usize) -> f64 {
     let (m, d, dx) = (
