@@ -108,9 +108,25 @@ impl PrssmModel {
     /// [`ModelFileError`] naming the file: unreadable, malformed/truncated, wrong format,
     /// future version, inconsistent contents.
     pub fn load(path: &Path) -> Result<Self, ModelFileError> {
-        let text = std::fs::read_to_string(path).map_err(|source| ModelFileError::Io {
+        let bytes = std::fs::read(path).map_err(|source| ModelFileError::Io {
             path: path.to_path_buf(),
             source,
+        })?;
+        let not_json = |message: &str| ModelFileError::Parse {
+            path: path.to_path_buf(),
+            message: message.to_string(),
+        };
+        if bytes.starts_with(b"PK\x03\x04") {
+            return Err(not_json(
+                "a zip (.npz) archive, not a JSON model file (the authors' published .npz \
+                 is converted by `flapssm model import-published`)",
+            ));
+        }
+        let text = String::from_utf8(bytes).map_err(|e| {
+            not_json(&format!(
+                "not UTF-8 text (byte {})",
+                e.utf8_error().valid_up_to()
+            ))
         })?;
         Self::from_json(&text, path)
     }

@@ -110,4 +110,18 @@ fn bad_files_give_clear_errors() {
         matches!(e, ModelFileError::Io { .. }) && e.to_string().contains("missing.json"),
         "{e}"
     );
+
+    // Binary files: an .npz (zip) archive gets a pointer to the importer, other bytes the
+    // offset of the first byte that is not UTF-8.
+    let npz = dir.path().join("published.npz");
+    std::fs::write(&npz, b"PK\x03\x04\x14\x00rest of a zip").unwrap();
+    let e = PrssmModel::load(&npz).unwrap_err();
+    assert!(
+        e.to_string().contains("published.npz") && e.to_string().contains("import-published"),
+        "{e}"
+    );
+    let bin = dir.path().join("model.bin");
+    std::fs::write(&bin, b"{\"a\xff").unwrap();
+    let e = PrssmModel::load(&bin).unwrap_err();
+    assert!(e.to_string().contains("not UTF-8 text (byte 3)"), "{e}");
 }
