@@ -170,14 +170,13 @@ impl Posterior {
 
     /// Maps `B = Σ A Wᵀ` (`M × M`, see the module doc) to `∂loss/∂K_mm` (`M × M`,
     /// column-major; every entry treated as independent): unwhitened `K̄_mm = −B`; whitened
-    /// `L̄ = −tril(B)` (the adjoint of `W = L⁻¹K`), then the Cholesky adjoint. `b` is
-    /// overwritten.
-    pub(crate) fn kmm_grad(&self, b: &mut [f64]) -> Vec<f64> {
+    /// `L̄ = −tril(B)` (the adjoint of `W = L⁻¹K`), then the Cholesky adjoint.
+    pub(crate) fn kmm_grad(&self, mut b: Vec<f64>) -> Vec<f64> {
         b.iter_mut().for_each(|v| *v = -*v);
         if self.whitened {
-            cholesky_backward(&self.l, b, self.m)
+            cholesky_backward(&self.l, &mut b, self.m)
         } else {
-            b.to_vec()
+            b
         }
     }
 }

@@ -506,7 +506,7 @@ impl Elbo {
         g: &mut ParamGrads,
     ) {
         let (m, d) = (post.m, post.d);
-        let (q_mean_bar, mut b_kmm) = cond.split_stacked(post);
+        let (q_mean_bar, b_kmm) = cond.split_stacked(post);
         g.q_mean
             .iter_mut()
             .zip(q_mean_bar.iter().zip(&kl.q_mean))
@@ -515,7 +515,7 @@ impl Elbo {
             .iter_mut()
             .zip(cond.q_cov.iter().zip(&kl.q_cov))
             .for_each(|(a, (b, c))| *a += b + c);
-        let mut kbar = post.kmm_grad(&mut b_kmm);
+        let mut kbar = post.kmm_grad(b_kmm);
         if let Some(kk) = &kl.kmm {
             kbar.iter_mut().zip(kk).for_each(|(a, b)| *a += b);
         }
