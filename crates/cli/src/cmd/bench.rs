@@ -4,8 +4,9 @@
 use anyhow::Context;
 use clap::Args;
 use flapssm_prssm::train::bench::{
-    AUTHORS_EPOCH_S, AUTHORS_PREDICT_S, gemm_rate_gflops, paper_model, paper_objective,
-    predict_step_flops, time_batches, time_prediction, time_stream_step,
+    AUTHORS_EPOCH_S, AUTHORS_PREDICT_S, REFERENCE_SOLVE_S, gemm_rate_gflops, paper_model,
+    paper_objective, predict_step_flops, reference_solve_seconds, time_batches, time_prediction,
+    time_stream_step,
 };
 
 /// Steps of the timed prediction (the authors' trajectory length).
@@ -30,6 +31,14 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
     let threads = rayon::current_num_threads();
     let gemm = gemm_rate_gflops(512, 0.3);
     println!("this machine: f64 GEMM (512 x 512 x 512, faer, 1 thread) {gemm:.1} GFLOP/s per core");
+    let solve = reference_solve_seconds(0.2);
+    println!(
+        "  faer triangular solve (100 x 100, 480 right-hand sides, 1 thread): {:.1} us; \
+         ~{:.0} us on the machine of the authors' timings (prssm-notes 4): x{:.2} its speed",
+        solve * 1e6,
+        REFERENCE_SOLVE_S * 1e6,
+        REFERENCE_SOLVE_S / solve
+    );
     let (elbo, params) =
         paper_objective(512, 470, args.seed).context("building the paper objective")?;
     let n_batches = usize::from(args.batches);
