@@ -70,7 +70,8 @@ pub fn exp(x: f64) -> f64 {
         2.762_007_587_998_336_7e-7,
         2.510_037_583_256_123_4e-8,
     ];
-    // Below this, `eˣ < 2⁻¹⁰²²` would be subnormal and `2ᵏ` not a normal number.
+    // From here up `k ≥ −1022` and `r > 0` when `k = −1022`, so `p·2ᵏ` is normal and exact;
+    // below it (`−1022·ln2 = −708.396`) results are subnormal or within 0.07 % of `2⁻¹⁰²²`.
     const FLUSH: f64 = -708.39;
     let xc = if x > 709.0 { 709.0 } else { x };
     let t = xc.mul_add(std::f64::consts::LOG2_E, SHIFT);
