@@ -58,23 +58,21 @@ pub fn gemm_rate_gflops(size: usize, min_seconds: f64) -> f64 {
     let b = Mat::<f64>::from_fn(size, size, |i, j| ((i * 13 + j * 29) % 89) as f64 / 89.0);
     let mut c = Mat::<f64>::zeros(size, size);
     let flop = 2.0 * (size as f64).powi(3);
-    let mut best = f64::INFINITY;
-    let start = Instant::now();
-    let mut reps = 0;
-    while reps < 3 || start.elapsed().as_secs_f64() < min_seconds {
-        let t0 = Instant::now();
-        matmul(
-            c.as_mut(),
-            Accum::Replace,
-            a.as_ref(),
-            b.as_ref(),
-            1.0,
-            Par::Seq,
-        );
-        best = best.min(t0.elapsed().as_secs_f64());
-        std::hint::black_box(&c);
-        reps += 1;
-    }
+    let best = fastest_seconds(
+        min_seconds,
+        &mut c,
+        |_| {},
+        |c| {
+            matmul(
+                c.as_mut(),
+                Accum::Replace,
+                a.as_ref(),
+                b.as_ref(),
+                1.0,
+                Par::Seq,
+            )
+        },
+    );
     flop / best / 1e9
 }
 
@@ -91,15 +89,31 @@ pub const REFERENCE_SOLVE_S: f64 = 0.08e-3;
 pub fn reference_solve_seconds(min_seconds: f64) -> f64 {
     let (l, b) = reference_system();
     let mut x = b.clone();
+    fastest_seconds(
+        min_seconds,
+        &mut x,
+        |x| x.copy_from(&b),
+        |x| solve_lower_triangular_in_place(l.as_ref(), x.as_mut(), Par::Seq),
+    )
+}
+
+/// The fastest of at least 3 runs of `timed` on `state` over at least `min_seconds` (s), each
+/// after an untimed `prepare`.
+fn fastest_seconds<S>(
+    min_seconds: f64,
+    state: &mut S,
+    mut prepare: impl FnMut(&mut S),
+    mut timed: impl FnMut(&mut S),
+) -> f64 {
     let mut best = f64::INFINITY;
     let start = Instant::now();
     let mut reps = 0;
     while reps < 3 || start.elapsed().as_secs_f64() < min_seconds {
-        x.copy_from(&b);
+        prepare(state);
         let t0 = Instant::now();
-        solve_lower_triangular_in_place(l.as_ref(), x.as_mut(), Par::Seq);
+        timed(state);
         best = best.min(t0.elapsed().as_secs_f64());
-        std::hint::black_box(&x);
+        std::hint::black_box(&*state);
         reps += 1;
     }
     best
