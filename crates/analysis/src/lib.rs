@@ -13,26 +13,18 @@
 //! | [`authority`] | control-authority analysis (Fig. 5 as data, JSON/CSV) | `plotter.m` |
 //! | [`plots`] | PNG/SVG figures (Figs. 2C, 3, 4, 5, training curves) | — |
 //! | [`report`] | one self-contained HTML page | — |
-//! | [`pipeline`] | evaluation of both models on a dataset: metrics, authority, figures, report | — |
-//! | [`sweep`] | one-configuration PR-SSM sweep runs (D_x, training-set size) and their merge | — |
-//! | [`demo`] | the one-command demo: simulate, fit, train, evaluate (resumable) | — |
-//! | [`sysid`] | Doerr et al. system-identification protocol (fit, open-loop test, RMSE/NLL) | — |
 //!
 //! Features: `parallel` (default) runs the per-trajectory cross-correlations on rayon.
 #![warn(missing_docs)]
 
 pub mod authority;
 pub mod cycles_avg;
-pub mod demo;
 pub mod error;
 pub mod kde;
 pub mod metrics;
-pub mod pipeline;
 pub mod plots;
 pub mod report;
 pub mod stats;
-pub mod sweep;
-pub mod sysid;
 pub mod xcorr;
 
 pub use error::{AnalysisError, Result};

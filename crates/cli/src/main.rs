@@ -4,6 +4,7 @@
 use clap::{Parser, Subcommand};
 
 mod cmd;
+mod progress;
 
 /// Compact probabilistic state-space models of flapping-wing aerodynamics.
 #[derive(Parser)]

@@ -11,6 +11,7 @@
 //! | [`authority`] | Fig. 5: HDR contours and modes, per-pair scatter, summary circle grid |
 //! | [`wing3d`] | Fig. 2C: 3-D wing-motion sketches (chord lines along the path, LE dotted) |
 //! | [`training`] | training curves |
+//! | [`sweep`] | accuracy against a swept setting (D_x, training-set size) |
 //! | [`sysid`] | system identification: test-part prediction with ±2σ band |
 
 use std::path::{Path, PathBuf};
@@ -23,6 +24,7 @@ use crate::error::{AnalysisError, Result};
 
 pub mod authority;
 pub mod errors;
+pub mod sweep;
 pub mod sysid;
 pub mod timeseries;
 pub mod training;

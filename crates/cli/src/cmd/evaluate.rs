@@ -4,12 +4,12 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 use clap::Args;
-use flapssm_analysis::pipeline::{EvalOptions, ReportContext, evaluate};
 use flapssm_data::Dataset;
+use flapssm_jobs::pipeline::{EvalOptions, ReportContext, evaluate};
 use flapssm_prssm::PrssmModel;
 use flapssm_qs::LrqsmModel;
 
-use super::demo::Bars;
+use crate::progress::Bars;
 
 /// Evaluate a PR-SSM and an LRQSM on a dataset's training and test trajectories.
 #[derive(Args)]

@@ -21,20 +21,6 @@ pub fn positive<T: std::str::FromStr + PartialOrd + From<u8>>(s: &str) -> Result
     }
 }
 
-/// A progress bar on stderr for `len` items (drawn only when stderr is a terminal).
-pub fn progress_bar(len: u64, items: &str) -> anyhow::Result<indicatif::ProgressBar> {
-    use anyhow::Context;
-    let bar = indicatif::ProgressBar::new(len);
-    bar.set_style(
-        indicatif::ProgressStyle::with_template(&format!(
-            "{{elapsed_precise}} [{{bar:30}}] {{pos}}/{{len}} {items} (eta {{eta}})"
-        ))
-        .context("progress bar template")?
-        .progress_chars("=> "),
-    );
-    Ok(bar)
-}
-
 /// The error and its causes joined by ": ", skipping a cause whose text the message already
 /// holds (many library errors repeat their source, e.g. `file: No such file (os error 2)`).
 pub fn error_message(err: &anyhow::Error) -> String {

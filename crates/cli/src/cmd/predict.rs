@@ -110,7 +110,7 @@ fn run_dataset(args: PredictArgs) -> anyhow::Result<()> {
         );
     }
     let bare = model.normalization.is_none();
-    let model = flapssm_analysis::pipeline::in_dataset_units(&model, &ds)
+    let model = flapssm_jobs::pipeline::in_dataset_units(&model, &ds)
         .with_context(|| {
             format!(
                 "{} has no normalization statistics (standardized units) and {} has none to \
@@ -129,13 +129,13 @@ fn run_dataset(args: PredictArgs) -> anyhow::Result<()> {
         );
     }
     let (n, t_n) = (ds.len(), ds.n_samples());
-    let bar = super::progress_bar(n as u64, "trajectories")?;
+    let bar = crate::progress::progress_bar(n as u64, "trajectories")?;
     let preds = ds
         .trajectories
         .par_iter()
         .enumerate()
         .map(|(i, traj)| {
-            let seq = flapssm_analysis::pipeline::trajectory_sequence(traj);
+            let seq = flapssm_jobs::pipeline::trajectory_sequence(traj);
             let p = predict_raw(
                 &model,
                 &seq,

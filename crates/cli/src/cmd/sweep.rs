@@ -4,12 +4,12 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 use clap::{Args, Subcommand};
-use flapssm_analysis::pipeline::{TrainingOptions, save_json};
-use flapssm_analysis::sweep::{SweepKind, SweepTable, load_result, sweep_run};
 use flapssm_data::Dataset;
+use flapssm_jobs::pipeline::{TrainingOptions, save_json};
+use flapssm_jobs::sweep::{SweepKind, SweepTable, load_result, sweep_run};
 use flapssm_prssm::train::fit::Preset;
 
-use super::demo::{Bars, stop_flag};
+use crate::progress::{Bars, stop_flag};
 
 /// Sweep subcommands.
 #[derive(Subcommand)]

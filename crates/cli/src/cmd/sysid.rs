@@ -1,12 +1,12 @@
 //! `flapssm sysid FILE --input COL --output COL`: the Doerr et al. system-identification
-//! protocol on a recorded input/output table (see `flapssm_analysis::sysid`).
+//! protocol on a recorded input/output table (see `flapssm_jobs::sysid`).
 
 use std::path::PathBuf;
 
 use anyhow::Context;
 use clap::Args;
-use flapssm_analysis::sysid::{Combine, IoRecord, SeedRun, SysidSpec, run as run_protocol};
 use flapssm_data::table::Column;
+use flapssm_jobs::sysid::{Combine, IoRecord, SeedRun, SysidSpec, run as run_protocol};
 use flapssm_prssm::train::LrSchedule;
 
 /// Fit a PR-SSM on the first part of a record, simulate the rest open loop, report test

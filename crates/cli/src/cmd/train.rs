@@ -6,8 +6,8 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 use anyhow::{Context, bail};
 use clap::Args;
-use flapssm_analysis::pipeline::{TrainingOptions, trajectory_sequence};
 use flapssm_data::Dataset;
+use flapssm_jobs::pipeline::{TrainingOptions, trajectory_sequence};
 use flapssm_prssm::Sequence;
 use flapssm_prssm::train::fit::{Preset, fit};
 use flapssm_prssm::train::{Budget, Checkpoint, LrSchedule, TrainEvent, TrainHooks};

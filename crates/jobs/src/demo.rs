@@ -33,7 +33,7 @@ use crate::pipeline::{
     AuthorityFinding, EvalOptions, EvaluationReport, PipelineError, Progress, ReportContext,
     Result, TrainingOptions, evaluate, load_json, save_json, train_prssm, versions,
 };
-use crate::stats::{Interval, median};
+use flapssm_analysis::stats::{Interval, median};
 
 /// Format tag of `summary.json`.
 pub const SUMMARY_FORMAT: &str = "flapssm-demo-summary";

@@ -2,14 +2,14 @@
 //! record is split again (first 75 % fit, last 25 % validation, open loop) and each variant
 //! of the fit is scored there. Never looks at the test part.
 //!
-//! `cargo run --release -p flapssm-analysis --example sysid_validate -- FILE IN OUT VARIANT [SEEDS]`
+//! `cargo run --release -p flapssm-jobs --example sysid_validate -- FILE IN OUT VARIANT [SEEDS]`
 //! with VARIANT a comma-separated list of `reference`, `linear-recognition`, `lr=X`,
 //! `cosine=FINAL_FACTOR`, `restarts=R`, `select` (combine restarts by selection instead of
 //! the ensemble).
 
 use std::path::Path;
 
-use flapssm_analysis::sysid::{Combine, IoRecord, SysidSpec, run};
+use flapssm_jobs::sysid::{Combine, IoRecord, SysidSpec, run};
 use flapssm_prssm::train::{InitialStateSpec, LrSchedule, RecognitionConfig};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {

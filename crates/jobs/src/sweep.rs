@@ -14,15 +14,13 @@ use std::time::Instant;
 use flapssm_data::{Dataset, OUTPUT_NAMES};
 use flapssm_prssm::train::EpochRecord;
 use flapssm_prssm::train::fit::FitSpec;
-use plotters::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::metrics::PooledErrors;
 use crate::pipeline::{
     PipelineError, Progress, Result, TrainingOptions, predict_prssm, save_json, train_prssm,
 };
-use crate::plots::{PALETTE, bold, font, padded_range, render};
-use crate::stats::Rows;
+use flapssm_analysis::metrics::PooledErrors;
+use flapssm_analysis::stats::Rows;
 
 /// Format tag of a sweep result file.
 pub const RESULT_FORMAT: &str = "flapssm-sweep-result";
@@ -374,95 +372,44 @@ impl SweepTable {
         })
     }
 
-    /// Overall training and test RMSE vs the swept value, one panel per kind (mean over seeds
-    /// as a line, each run as a dot).
+    /// Overall training and test RMSE vs the swept value, one panel per kind
+    /// ([`flapssm_analysis::plots::sweep::accuracy_vs_setting`]).
     ///
     /// # Errors
     /// Plot and I/O errors.
-    pub fn figure(&self, path: &Path) -> crate::Result<()> {
+    pub fn figure(&self, path: &Path) -> flapssm_analysis::Result<()> {
+        use flapssm_analysis::plots::sweep::{SweepPanel, SweepPoint, accuracy_vs_setting};
         let mut kinds: Vec<SweepKind> = self.rows.iter().map(|r| r.kind).collect();
         kinds.dedup();
-        render!(path, (560 * kinds.len() as u32, 440), |root| {
-            let areas = root.split_evenly((1, kinds.len()));
-            for (area, kind) in areas.iter().zip(&kinds) {
-                let rows: Vec<&SweepRow> = self.rows.iter().filter(|r| r.kind == *kind).collect();
-                let xs = rows.iter().map(|r| r.value as f64).collect::<Vec<_>>();
-                let ys = rows
+        let points: Vec<Vec<SweepPoint>> = kinds
+            .iter()
+            .map(|k| {
+                self.rows
                     .iter()
-                    .flat_map(|r| std::iter::once(r.train_overall).chain(r.test_overall))
-                    .collect::<Vec<_>>();
-                let (x0, x1) = padded_range(xs.iter(), 0.08);
-                let (_, y1) = padded_range(ys.iter(), 0.1);
-                let mut ch = ChartBuilder::on(area)
-                    .caption(
-                        match kind {
-                            SweepKind::Dx => "accuracy vs latent dimension D_x",
-                            SweepKind::DataSize => "accuracy vs training trajectories",
-                        },
-                        bold(18.0),
-                    )
-                    .margin(12)
-                    .x_label_area_size(40)
-                    .y_label_area_size(60)
-                    .build_cartesian_2d(x0..x1, 0.0..y1)?;
-                ch.configure_mesh()
-                    .x_desc(match kind {
-                        SweepKind::Dx => "D_x",
-                        SweepKind::DataSize => "training trajectories",
+                    .filter(|r| r.kind == *k)
+                    .map(|r| SweepPoint {
+                        value: r.value,
+                        train: r.train_overall,
+                        test: r.test_overall,
                     })
-                    .y_desc("overall RMSE (σ units)")
-                    .label_style(font(14.0))
-                    .light_line_style(RGBColor(235, 235, 235))
-                    .draw()?;
-                let mut values: Vec<usize> = rows.iter().map(|r| r.value).collect();
-                values.dedup();
-                for (c, (label, get)) in [
-                    (
-                        "training",
-                        (|r: &SweepRow| Some(r.train_overall)) as fn(&SweepRow) -> Option<f64>,
-                    ),
-                    ("test", |r: &SweepRow| r.test_overall),
-                ]
-                .into_iter()
-                .enumerate()
-                {
-                    let col = PALETTE[c];
-                    let pts: Vec<(f64, f64)> = rows
-                        .iter()
-                        .filter_map(|r| get(r).map(|v| (r.value as f64, v)))
-                        .collect();
-                    if pts.is_empty() {
-                        continue;
-                    }
-                    let means: Vec<(f64, f64)> = values
-                        .iter()
-                        .filter_map(|&v| {
-                            let s: Vec<f64> = rows
-                                .iter()
-                                .filter(|r| r.value == v)
-                                .filter_map(|r| get(r))
-                                .collect();
-                            (!s.is_empty())
-                                .then(|| (v as f64, s.iter().sum::<f64>() / s.len() as f64))
-                        })
-                        .collect();
-                    ch.draw_series(LineSeries::new(means, col.stroke_width(2)))?
-                        .label(label)
-                        .legend(move |(x, y)| {
-                            PathElement::new(vec![(x, y), (x + 22, y)], col.stroke_width(3))
-                        });
-                    ch.draw_series(
-                        pts.iter()
-                            .map(|&(x, y)| Circle::new((x, y), 4, col.filled())),
-                    )?;
-                }
-                ch.configure_series_labels()
-                    .label_font(font(14.0))
-                    .background_style(WHITE.mix(0.85))
-                    .border_style(RGBColor(180, 180, 180))
-                    .draw()?;
-            }
-            Ok::<(), Box<dyn std::error::Error>>(())
-        })
+                    .collect()
+            })
+            .collect();
+        let panels: Vec<SweepPanel<'_>> = kinds
+            .iter()
+            .zip(&points)
+            .map(|(kind, points)| SweepPanel {
+                title: match kind {
+                    SweepKind::Dx => "accuracy vs latent dimension D_x",
+                    SweepKind::DataSize => "accuracy vs training trajectories",
+                },
+                x_label: match kind {
+                    SweepKind::Dx => "D_x",
+                    SweepKind::DataSize => "training trajectories",
+                },
+                points,
+            })
+            .collect();
+        accuracy_vs_setting(path, &panels)
     }
 }

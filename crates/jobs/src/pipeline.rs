@@ -13,7 +13,7 @@
 //! - Coefficients `C_F = F/(½ρSU_ref²)`, `C_M = M/(½ρc̄SU_ref²·1000)` per trajectory; the last
 //!   full cycle from [`flapssm_wing::cycles::published_window`]; per-trajectory C_Fx/C_Fy RMSE
 //!   over it; half-stroke averages and their errors (measured − predicted) with intervals.
-//! - Control authority: [`crate::authority`] on (inputs, PR-SSM latent means) from
+//! - Control authority: [`flapssm_analysis::authority`] on (inputs, PR-SSM latent means) from
 //!   `start_sample` on, every trajectory (training and test), period = the cycle duration.
 
 use std::path::{Path, PathBuf};
@@ -29,14 +29,18 @@ use flapssm_qs::{InterceptMode, LrqsmModel, QsError};
 use flapssm_wing::cycles::{CycleError, published_window};
 use serde::{Deserialize, Serialize};
 
-use crate::authority::{AuthorityConfig, AuthoritySummary, AuthorityTrajectory, peak_table};
-use crate::cycles_avg::{CycleAverageErrors, CycleWindow};
-use crate::error::AnalysisError;
-use crate::metrics::{CoefficientScales, Histogram, PUBLISHED_START_SAMPLE, PooledErrors};
-use crate::metrics::{coefficients_of, window_rmse};
-use crate::plots::{authority as pa, errors as pe, timeseries as pt, training, wing3d};
-use crate::report::{Figure, Report, Section, Table};
-use crate::stats::{Interval, Rows, median};
+use flapssm_analysis::authority::{
+    AuthorityConfig, AuthoritySummary, AuthorityTrajectory, peak_table,
+};
+use flapssm_analysis::cycles_avg::{CycleAverageErrors, CycleWindow};
+use flapssm_analysis::error::AnalysisError;
+use flapssm_analysis::metrics::{
+    CoefficientScales, Histogram, PUBLISHED_START_SAMPLE, PooledErrors,
+};
+use flapssm_analysis::metrics::{coefficients_of, window_rmse};
+use flapssm_analysis::plots::{authority as pa, errors as pe, timeseries as pt, training, wing3d};
+use flapssm_analysis::report::{Figure, Report, Section, Table};
+use flapssm_analysis::stats::{Interval, Rows, median};
 
 /// Display names of the 7 inputs (dataset order).
 pub const INPUT_LABELS: [&str; 7] = ["AoA", "|v|", "a_x", "a_y", "a_z", "dα/dt", "d²α/dt²"];
@@ -995,7 +999,7 @@ fn draw_fig3(
                     .clone()
                     .map(|k| p.measured_c[k * 5 + j] - v[k * 5 + j])
                     .collect();
-                crate::metrics::rms(&e)
+                flapssm_analysis::metrics::rms(&e)
             };
             Ok(Data {
                 t: (0..=p.window.duration)
