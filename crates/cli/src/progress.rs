@@ -1,11 +1,11 @@
-//! Progress on the terminal: indicatif bars implementing [`flapssm_jobs::pipeline::Progress`],
+//! Progress on the terminal: indicatif bars implementing [`flapssm_jobs::Progress`],
 //! and the stop flag that Ctrl-C sets.
 
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 
 use anyhow::Context;
-use flapssm_jobs::pipeline::Progress;
+use flapssm_jobs::Progress;
 use indicatif::{ProgressBar, ProgressStyle};
 
 /// Progress bars: one per stage, lines printed above.

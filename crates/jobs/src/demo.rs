@@ -29,10 +29,13 @@ use flapssm_wing::features::FeatureSet;
 use flapssm_wing::virtual_wing::{Fidelity, SimulationConfig, simulate_dataset};
 use serde::{Deserialize, Serialize};
 
-use crate::pipeline::{
-    AuthorityFinding, EvalOptions, EvaluationReport, PipelineError, Progress, ReportContext,
-    Result, TrainingOptions, evaluate, load_json, save_json, train_prssm, versions,
+use crate::error::{JobError, Result};
+use crate::evaluate::{
+    AuthorityFinding, EvalOptions, EvaluationReport, ReportContext, evaluate, versions,
 };
+use crate::files::{load_json, save_json};
+use crate::progress::Progress;
+use crate::train::{TrainingOptions, train_prssm};
 use flapssm_analysis::stats::{Interval, median};
 
 /// Format tag of `summary.json`.
@@ -266,7 +269,7 @@ fn json<T: Serialize>(v: &T) -> serde_json::Value {
 /// then be resumed by running again with the same configuration.
 ///
 /// # Errors
-/// Any stage's error, naming the stage's file; [`PipelineError::Interrupted`] when stopped.
+/// Any stage's error, naming the stage's file; [`JobError::Interrupted`] when stopped.
 pub fn run_demo(
     dir: &Path,
     cfg: &DemoConfig,
@@ -274,7 +277,7 @@ pub fn run_demo(
     stop: Option<&AtomicBool>,
 ) -> Result<DemoSummary> {
     let t_all = Instant::now();
-    std::fs::create_dir_all(dir).map_err(|source| PipelineError::Io {
+    std::fs::create_dir_all(dir).map_err(|source| JobError::Io {
         path: dir.to_path_buf(),
         source,
     })?;
@@ -303,11 +306,10 @@ pub fn run_demo(
             let n = cfg.simulation.trajectories.n_trajectories as u64;
             p.start("simulate", n);
             let ds = simulate_dataset(&cfg.simulation, &|| p.advance(1))?;
-            ds.save(&ds_path)
-                .map_err(|source| PipelineError::DatasetFile {
-                    path: ds_path.clone(),
-                    source,
-                })?;
+            ds.save(&ds_path).map_err(|source| JobError::DatasetFile {
+                path: ds_path.clone(),
+                source,
+            })?;
             p.finish(&format!("{} trajectories", ds.len()));
             Ok(ds)
         },
@@ -351,7 +353,7 @@ pub fn run_demo(
             && ck_path.exists())
         .then(|| Checkpoint::load(&ck_path))
         .transpose()
-        .map_err(|e| PipelineError::Io {
+        .map_err(|e| JobError::Io {
             path: ck_path.clone(),
             source: std::io::Error::other(e.to_string()),
         })?
@@ -382,7 +384,7 @@ pub fn run_demo(
                 }
                 let out = train_prssm(ds.train(), &cfg.training, Some(&ck_path), resume, p, stop)?;
                 for (m, path) in [(&out.best, &pm_path), (&out.last, &last_path)] {
-                    m.save(path).map_err(|source| PipelineError::ModelFile {
+                    m.save(path).map_err(|source| JobError::ModelFile {
                         path: path.clone(),
                         source,
                     })?;
@@ -444,14 +446,14 @@ pub fn run_demo(
 }
 
 fn load_dataset(path: &Path) -> Result<Dataset> {
-    Dataset::load(path).map_err(|source| PipelineError::DatasetFile {
+    Dataset::load(path).map_err(|source| JobError::DatasetFile {
         path: path.to_path_buf(),
         source,
     })
 }
 
 fn load_model(path: &Path) -> Result<PrssmModel> {
-    PrssmModel::load(path).map_err(|source| PipelineError::ModelFile {
+    PrssmModel::load(path).map_err(|source| JobError::ModelFile {
         path: path.to_path_buf(),
         source,
     })

@@ -5,15 +5,30 @@
 //!
 //! | module | job |
 //! |---|---|
-//! | [`pipeline`] | evaluation of both models on a dataset: metrics, authority, figures, report; PR-SSM training on a dataset |
+//! | [`train`] | PR-SSM training on a dataset's training trajectories (settings, checkpoints, resume) |
+//! | [`predict`] | open-loop predictions of every trajectory of a dataset (PR-SSM, LRQSM) |
+//! | [`evaluate`] | both models on a dataset: metrics, authority, figures, report |
 //! | [`sweep`] | one-configuration PR-SSM sweep runs (D_x, training-set size) and their merge |
 //! | [`demo`] | the one-command demo: simulate, fit, train, evaluate (resumable) |
 //! | [`sysid`] | Doerr et al. system-identification protocol (fit, open-loop test, RMSE/NLL) |
+//!
+//! Shared pieces: [`error`] (one error type naming the file, trajectory or stage), [`progress`]
+//! (the progress sink a caller supplies), [`seed`] (the one seed-derivation rule), [`files`]
+//! (atomic JSON and text files).
 //!
 //! Features: `parallel` (default) predicts trajectories and runs restarts on rayon.
 #![warn(missing_docs)]
 
 pub mod demo;
-pub mod pipeline;
+pub mod error;
+pub mod evaluate;
+pub mod files;
+pub mod predict;
+pub mod progress;
+pub mod seed;
 pub mod sweep;
 pub mod sysid;
+pub mod train;
+
+pub use error::{JobError, Result};
+pub use progress::{NoProgress, Progress};

@@ -16,9 +16,11 @@ use flapssm_prssm::train::EpochRecord;
 use flapssm_prssm::train::fit::FitSpec;
 use serde::{Deserialize, Serialize};
 
-use crate::pipeline::{
-    PipelineError, Progress, Result, TrainingOptions, predict_prssm, save_json, train_prssm,
-};
+use crate::error::{JobError, Result};
+use crate::files::save_json;
+use crate::predict::predict_prssm;
+use crate::progress::Progress;
+use crate::train::{TrainingOptions, train_prssm};
 use flapssm_analysis::metrics::PooledErrors;
 use flapssm_analysis::stats::Rows;
 
@@ -118,7 +120,7 @@ pub struct SweepResult {
 /// `particles` particles and `seed`; errors count from `start_sample` on.
 ///
 /// # Errors
-/// [`PipelineError::Mismatch`] for a value that does not fit the dataset (data-size larger than
+/// [`JobError::Mismatch`] for a value that does not fit the dataset (data-size larger than
 /// the training set or below 2), training and prediction errors.
 #[allow(clippy::too_many_arguments)]
 pub fn sweep_run(
@@ -144,7 +146,7 @@ pub fn sweep_run(
         }
         SweepKind::DataSize => {
             if value < 2 || value > n_train {
-                return Err(PipelineError::Mismatch {
+                return Err(JobError::Mismatch {
                     what: "data-size value".into(),
                     expected: format!("2 ..= {n_train} (the training trajectories)"),
                     found: value.to_string(),
@@ -193,7 +195,7 @@ pub fn sweep_run(
             v.iter()
                 .map(|x| Rows::new(x, 5))
                 .collect::<std::result::Result<_, _>>()
-                .map_err(|source| PipelineError::Analysis {
+                .map_err(|source| JobError::Analysis {
                     what: "sweep errors".into(),
                     source,
                 })
@@ -203,7 +205,7 @@ pub fn sweep_run(
             &rows(&predz[r.clone()])?,
             start_sample,
         )
-        .map_err(|source| PipelineError::Analysis {
+        .map_err(|source| JobError::Analysis {
             what: "sweep errors".into(),
             source,
         })?;
@@ -213,7 +215,7 @@ pub fn sweep_run(
             overall: e.overall_rmse(),
         }))
     };
-    let train_rmse = set(0..used)?.ok_or_else(|| PipelineError::Mismatch {
+    let train_rmse = set(0..used)?.ok_or_else(|| JobError::Mismatch {
         what: "training trajectories".into(),
         expected: "at least one".into(),
         found: "none".into(),
@@ -240,20 +242,20 @@ pub fn sweep_run(
 /// Reads a sweep result file, checking its format tag and version.
 ///
 /// # Errors
-/// [`PipelineError::Io`] / [`PipelineError::Json`] naming the file, [`PipelineError::Mismatch`]
+/// [`JobError::Io`] / [`JobError::Json`] naming the file, [`JobError::Mismatch`]
 /// for another format or version.
 pub fn load_result(path: &Path) -> Result<SweepResult> {
-    let v: serde_json::Value = crate::pipeline::load_json(path)?;
+    let v: serde_json::Value = crate::files::load_json(path)?;
     let format = v.get("format").and_then(|f| f.as_str()).unwrap_or("");
     let version = v.get("version").and_then(|f| f.as_u64()).unwrap_or(0);
     if format != RESULT_FORMAT || version != u64::from(RESULT_VERSION) {
-        return Err(PipelineError::Mismatch {
+        return Err(JobError::Mismatch {
             what: format!("{}: format/version", path.display()),
             expected: format!("{RESULT_FORMAT} version {RESULT_VERSION}"),
             found: format!("{format:?} version {version}"),
         });
     }
-    serde_json::from_value(v).map_err(|source| PipelineError::Json {
+    serde_json::from_value(v).map_err(|source| JobError::Json {
         path: path.to_path_buf(),
         source,
     })
@@ -293,10 +295,10 @@ impl SweepTable {
     /// Builds the table from `(source name, result)` pairs.
     ///
     /// # Errors
-    /// [`PipelineError::Mismatch`] for no results.
+    /// [`JobError::Mismatch`] for no results.
     pub fn new(results: &[(String, SweepResult)]) -> Result<Self> {
         if results.is_empty() {
-            return Err(PipelineError::Mismatch {
+            return Err(JobError::Mismatch {
                 what: "sweep results".into(),
                 expected: "at least one result file".into(),
                 found: "none".into(),
@@ -359,14 +361,14 @@ impl SweepTable {
     /// I/O and figure errors naming the file.
     pub fn write(&self, table: &Path) -> Result<()> {
         flapssm_data::atomic::write_bytes_atomic(table, self.to_csv().as_bytes()).map_err(
-            |source| PipelineError::Io {
+            |source| JobError::Io {
                 path: table.to_path_buf(),
                 source,
             },
         )?;
         save_json(&table.with_extension("json"), self)?;
         let fig = table.with_extension("png");
-        self.figure(&fig).map_err(|source| PipelineError::Analysis {
+        self.figure(&fig).map_err(|source| JobError::Analysis {
             what: "sweep figure".into(),
             source,
         })

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use anyhow::Context;
 use clap::Args;
 use flapssm_data::Dataset;
-use flapssm_jobs::pipeline::{EvalOptions, ReportContext, evaluate};
+use flapssm_jobs::evaluate::{EvalOptions, ReportContext, evaluate};
 use flapssm_prssm::PrssmModel;
 use flapssm_qs::LrqsmModel;
 

@@ -110,7 +110,7 @@ fn run_dataset(args: PredictArgs) -> anyhow::Result<()> {
         );
     }
     let bare = model.normalization.is_none();
-    let model = flapssm_jobs::pipeline::in_dataset_units(&model, &ds)
+    let model = flapssm_jobs::predict::in_dataset_units(&model, &ds)
         .with_context(|| {
             format!(
                 "{} has no normalization statistics (standardized units) and {} has none to \
@@ -135,7 +135,7 @@ fn run_dataset(args: PredictArgs) -> anyhow::Result<()> {
         .par_iter()
         .enumerate()
         .map(|(i, traj)| {
-            let seq = flapssm_jobs::pipeline::trajectory_sequence(traj);
+            let seq = flapssm_jobs::predict::trajectory_sequence(traj);
             let p = predict_raw(
                 &model,
                 &seq,

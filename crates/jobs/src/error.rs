@@ -1,0 +1,105 @@
+//! Errors of the jobs; each names the file, trajectory or stage at fault.
+
+use std::path::PathBuf;
+
+use flapssm_analysis::error::AnalysisError;
+use flapssm_prssm::train::fit::FitError;
+use flapssm_qs::QsError;
+use flapssm_wing::cycles::CycleError;
+
+/// Errors of the pipeline, the sweeps and the demo; each names the file, trajectory or stage.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum JobError {
+    /// The dataset is invalid or unsuitable.
+    #[error("dataset: {0}")]
+    Dataset(#[from] flapssm_data::DatasetError),
+    /// A dataset file could not be read or written.
+    #[error("dataset file {path}: {source}")]
+    DatasetFile {
+        /// The file.
+        path: PathBuf,
+        /// Cause.
+        source: flapssm_data::StoreError,
+    },
+    /// A PR-SSM model file could not be read or written.
+    #[error("PR-SSM model file {path}: {source}")]
+    ModelFile {
+        /// The file.
+        path: PathBuf,
+        /// Cause.
+        source: flapssm_prssm::ModelFileError,
+    },
+    /// The LRQSM failed (fit, prediction or model file).
+    #[error("LRQSM: {0}")]
+    Qs(#[from] QsError),
+    /// PR-SSM training or prediction failed.
+    #[error("PR-SSM {what}: {source}")]
+    Prssm {
+        /// What was being done (e.g. "prediction of trajectory 3").
+        what: String,
+        /// Cause.
+        source: FitError,
+    },
+    /// The simulator failed.
+    #[error("simulation: {0}")]
+    Simulate(#[from] flapssm_wing::virtual_wing::SimulateError),
+    /// No stroke cycle could be found in a trajectory.
+    #[error("trajectory {trajectory}: stroke cycle: {source}")]
+    Cycle {
+        /// Trajectory index (0-based).
+        trajectory: usize,
+        /// Cause.
+        source: CycleError,
+    },
+    /// An analysis, figure or report failed.
+    #[error("{what}: {source}")]
+    Analysis {
+        /// Which analysis or file.
+        what: String,
+        /// Cause.
+        source: AnalysisError,
+    },
+    /// Shapes or settings do not fit together.
+    #[error("{what}: expected {expected}, found {found}")]
+    Mismatch {
+        /// Which item.
+        what: String,
+        /// Expected, in words.
+        expected: String,
+        /// Found, in words.
+        found: String,
+    },
+    /// A file could not be read or written.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// Cause.
+        source: std::io::Error,
+    },
+    /// A JSON file could not be parsed or written.
+    #[error("{path}: {source}")]
+    Json {
+        /// The file.
+        path: PathBuf,
+        /// Cause (with line and column when parsing).
+        source: serde_json::Error,
+    },
+    /// Stopped on request; the training checkpoint allows resuming.
+    #[error("interrupted at step {step}; rerun the same command to resume from {checkpoint}")]
+    Interrupted {
+        /// Optimizer steps done.
+        step: u64,
+        /// Checkpoint file.
+        checkpoint: PathBuf,
+    },
+}
+
+/// Result alias of the pipeline.
+pub type Result<T> = std::result::Result<T, JobError>;
+
+pub(crate) fn analysis(what: impl Into<String>) -> impl FnOnce(AnalysisError) -> JobError {
+    let what = what.into();
+    move |source| JobError::Analysis { what, source }
+}

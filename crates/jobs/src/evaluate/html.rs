@@ -1,0 +1,316 @@
+//! The evaluation's HTML report: what it says and which figures it shows.
+
+use std::path::PathBuf;
+
+use flapssm_data::OUTPUT_NAMES;
+use flapssm_prssm::PrssmModel;
+use flapssm_prssm::train::fit::training_record;
+use flapssm_qs::LrqsmModel;
+
+use flapssm_analysis::report::{Figure, Report, Section, Table};
+use flapssm_analysis::stats::Interval;
+
+use super::{COEFFICIENT_LABELS, EvaluationReport, ModelMetrics, ReportContext};
+
+pub(super) struct ReportFigures {
+    pub(super) f_2c: PathBuf,
+    pub(super) f_3: PathBuf,
+    pub(super) f_4a_train: PathBuf,
+    pub(super) f_4a_test: Option<PathBuf>,
+    pub(super) f_4b: PathBuf,
+    pub(super) f_5a: PathBuf,
+    pub(super) f_5s: PathBuf,
+    pub(super) f_5b: PathBuf,
+    pub(super) training: Option<(PathBuf, PathBuf)>,
+}
+
+fn f3(v: f64) -> String {
+    format!("{v:.3}")
+}
+
+fn interval_cells(v: &[Interval]) -> Vec<String> {
+    v.iter()
+        .map(|i| format!("[{:.2}, {:.2}]", i.lo, i.hi))
+        .collect()
+}
+
+pub(super) fn html_report(
+    r: &EvaluationReport,
+    ctx: &ReportContext,
+    f: ReportFigures,
+    prssm: &PrssmModel,
+    lrqsm: &LrqsmModel,
+) -> Report {
+    let row = |label: String, cells: Vec<String>| std::iter::once(label).chain(cells).collect();
+    let header = |first: &str, names: &[&str]| -> Vec<String> {
+        std::iter::once(first.to_string())
+            .chain(names.iter().map(|s| s.to_string()))
+            .collect()
+    };
+    let mut rmse_rows = Vec::new();
+    let mut ci_rows = Vec::new();
+    let mut cyc_rows = Vec::new();
+    for m in [&r.prssm, &r.lrqsm] {
+        for (split, s) in [("train", Some(&m.train)), ("test", m.test.as_ref())] {
+            let Some(s) = s else { continue };
+            let mut cells: Vec<String> = s.rmse_standardized.iter().map(|v| f3(*v)).collect();
+            cells.push(f3(s.overall_rmse_standardized));
+            cells.push(format!(
+                "{:.3} / {:.3}",
+                s.median_cycle_rmse_cf[0], s.median_cycle_rmse_cf[1]
+            ));
+            rmse_rows.push(row(format!("{} {split}", m.model), cells));
+            ci_rows.push(row(
+                format!("{} {split}", m.model),
+                interval_cells(&s.error_interval),
+            ));
+            cyc_rows.push(row(
+                format!("{} {split}", m.model),
+                interval_cells(&s.cycle_average_error_interval),
+            ));
+        }
+        cyc_rows.push(row(
+            format!("{} train + test", m.model),
+            interval_cells(&m.cycle_average_error_interval_all),
+        ));
+    }
+    rmse_rows.push(row(
+        "ratio PR-SSM / LRQSM (test)".into(),
+        r.rmse_ratio.iter().map(|v| f3(*v)).collect(),
+    ));
+    let mut rmse_header = header("model, set", &OUTPUT_NAMES);
+    rmse_header.push("overall".into());
+    rmse_header.push("median last-cycle RMSE C_Fx / C_Fy".into());
+    let auth_rows: Vec<Vec<String>> = r
+        .authority_findings
+        .iter()
+        .map(|a| {
+            vec![
+                a.input.clone(),
+                a.state.clone(),
+                f3(a.median_abs_r),
+                f3(a.median_lag_cycles),
+                f3(a.lag_iqr_cycles),
+                f3(a.mode_lag_cycles),
+                if a.strong { "yes" } else { "no" }.into(),
+            ]
+        })
+        .collect();
+    let test_traj: Vec<Vec<String>> = r
+        .trajectories
+        .iter()
+        .filter(|t| t.split == "test")
+        .map(|t| {
+            vec![
+                format!("{}", t.index - r.n_train + 1),
+                t.family.clone(),
+                format!("{:.3}", t.u_ref_m_s),
+                t.period_samples.to_string(),
+                f3(t.prssm_cycle_rmse_cf[0]),
+                f3(t.lrqsm_cycle_rmse_cf[0]),
+                f3(t.prssm_cycle_rmse_cf[1]),
+                f3(t.lrqsm_cycle_rmse_cf[1]),
+            ]
+        })
+        .collect();
+    let overall = |m: &ModelMetrics| {
+        m.test
+            .as_ref()
+            .unwrap_or(&m.train)
+            .overall_rmse_standardized
+    };
+    let mut headline = vec![
+        (
+            "dataset".to_string(),
+            format!("{} ({} train / {} test)", r.dataset, r.n_train, r.n_test),
+        ),
+        (
+            "overall test RMSE PR-SSM / LRQSM (σ units)".into(),
+            format!("{:.3} / {:.3}", overall(&r.prssm), overall(&r.lrqsm)),
+        ),
+        (
+            "test RMSE ratio PR-SSM / LRQSM per output".into(),
+            r.rmse_ratio
+                .iter()
+                .zip(OUTPUT_NAMES)
+                .map(|(v, n)| format!("{n} {v:.2}"))
+                .collect::<Vec<_>>()
+                .join(", "),
+        ),
+    ];
+    for input in ["AoA", "a_x"] {
+        let lags: Vec<String> = r
+            .authority_findings
+            .iter()
+            .filter(|a| a.input == input)
+            .map(|a| format!("{} {:.2}", a.state, a.median_lag_cycles))
+            .collect();
+        headline.push((
+            format!("median lag of {input} → output states (cycles)"),
+            lags.join(", "),
+        ));
+    }
+    headline.extend(ctx.headline.iter().cloned());
+    let mut accuracy_figs = vec![
+        Figure {
+            caption: "Fig. 3 — last full cycle of test trajectories: chord sketch, Euler angles, measured and predicted C_Fx, C_Fy (title: last-cycle C_Fx RMSE PR-SSM/LRQSM)".into(),
+            path: f.f_3,
+        },
+        Figure {
+            caption: "Fig. 4A — standardized-error histograms, training set, with 95 % intervals".into(),
+            path: f.f_4a_train,
+        },
+    ];
+    if let Some(p) = f.f_4a_test {
+        accuracy_figs.push(Figure {
+            caption: "Fig. 4A — standardized-error histograms, test set, with 95 % intervals"
+                .into(),
+            path: p,
+        });
+    }
+    accuracy_figs.push(Figure {
+        caption: "Fig. 4B — half-stroke averages: error vs measured value, training and test, with 95 % intervals".into(),
+        path: f.f_4b,
+    });
+    let mut sections = vec![
+        Section {
+            heading: "Accuracy".into(),
+            paragraphs: vec![format!(
+                "Errors are measured − predicted. Standardized errors use the training mean and standard deviation of each output and samples from {} on (0-based; the first {} samples are dropped). Intervals are the {}-% central percentile intervals (MATLAB prctile). Cycle averages are half-stroke means of the load coefficients over the last full stroke cycle.",
+                r.options.start_sample, r.options.start_sample, r.options.level
+            )],
+            tables: vec![
+                Table {
+                    caption: "RMSE per output (σ units) and median last-cycle coefficient RMSE".into(),
+                    header: rmse_header,
+                    rows: rmse_rows,
+                },
+                Table {
+                    caption: "95 % intervals of the standardized errors".into(),
+                    header: header("model, set", &OUTPUT_NAMES),
+                    rows: ci_rows,
+                },
+                Table {
+                    caption: "95 % intervals of the half-stroke-average errors (coefficients)".into(),
+                    header: header("model, set", &COEFFICIENT_LABELS),
+                    rows: cyc_rows,
+                },
+                Table {
+                    caption: "Test trajectories: last-cycle RMSE of the force coefficients".into(),
+                    header: [
+                        "test #", "family", "U_ref (m/s)", "period (samples)",
+                        "C_Fx PR-SSM", "C_Fx LRQSM", "C_Fy PR-SSM", "C_Fy LRQSM",
+                    ]
+                    .iter()
+                    .map(|s| s.to_string())
+                    .collect(),
+                    rows: test_traj,
+                },
+            ],
+            figures: accuracy_figs,
+        },
+        Section {
+            heading: "Control authority (cross-correlation of the PR-SSM latent means)".into(),
+            paragraphs: vec![format!(
+                "Per trajectory, state and input: the largest |r| of the normalized cross-correlation (MATLAB crosscorr) over lags 0 < lag < {} cycle, state lagging input; pooled over all {} trajectories with a reflected 2-D Gaussian KDE (bandwidth {}).",
+                r.options.authority.max_lag_cycles,
+                r.n_train + r.n_test,
+                r.options.authority.bandwidth
+            )],
+            tables: vec![Table {
+                caption: "AoA and a_x on the output states".into(),
+                header: [
+                    "input", "state", "median max |r|", "median lag (cycles)",
+                    "lag IQR", "mode lag", "strong (median |r| > 0.5)",
+                ]
+                .iter()
+                .map(|s| s.to_string())
+                .collect(),
+                rows: auth_rows,
+            }],
+            figures: vec![
+                Figure {
+                    caption: "Fig. 5Ai — 70 % highest-density regions and modes (+)".into(),
+                    path: f.f_5a,
+                },
+                Figure {
+                    caption: "Fig. 5Aii — state x1: max |r| vs lag per trajectory".into(),
+                    path: f.f_5s,
+                },
+                Figure {
+                    caption: "Fig. 5B — summary: radius ∝ median max |r|, lightness ∝ lag IQR, median lag printed for strong pairs".into(),
+                    path: f.f_5b,
+                },
+            ],
+        },
+        Section {
+            heading: "Wing motions".into(),
+            figures: vec![Figure {
+                caption: "Fig. 2C — last full cycle of the example test trajectories (chord at the U_ref radius, LE dotted)".into(),
+                path: f.f_2c,
+            }],
+            ..Default::default()
+        },
+    ];
+    if let Some((loss, rmse)) = f.training {
+        sections.push(Section {
+            heading: "PR-SSM training".into(),
+            figures: vec![
+                Figure {
+                    caption: "Mean minibatch negative ELBO per epoch".into(),
+                    path: loss,
+                },
+                Figure {
+                    caption: "Open-loop RMSE on training and validation sequences".into(),
+                    path: rmse,
+                },
+            ],
+            ..Default::default()
+        });
+    }
+    let config = serde_json::json!({
+        "run": ctx.config,
+        "evaluation": r.options,
+        "prssm_model": prssm.config,
+        "prssm_training": training_record(prssm).ok().map(|t| t.spec),
+        "lrqsm": { "feature_set": lrqsm.feature_set, "options": lrqsm.options,
+                   "lambda": lrqsm.chosen.iter().map(|c| c.lambda).collect::<Vec<_>>() },
+    });
+    Report {
+        title: if ctx.title.is_empty() {
+            "flapssm evaluation: PR-SSM vs LRQSM".into()
+        } else {
+            ctx.title.clone()
+        },
+        intro: ctx.intro.clone(),
+        headline,
+        sections,
+        config,
+        versions: versions(),
+    }
+}
+
+/// Versions of the flapssm crates used.
+pub fn versions() -> Vec<(String, String)> {
+    vec![
+        ("flapssm".into(), env!("CARGO_PKG_VERSION").into()),
+        (
+            "build".into(),
+            if cfg!(debug_assertions) {
+                "debug"
+            } else {
+                "release"
+            }
+            .into(),
+        ),
+        (
+            "parallel".into(),
+            if cfg!(feature = "parallel") {
+                "rayon"
+            } else {
+                "off"
+            }
+            .into(),
+        ),
+    ]
+}

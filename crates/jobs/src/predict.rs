@@ -1,0 +1,200 @@
+//! Open-loop predictions of every trajectory of a dataset: the PR-SSM (mean, variance, latent
+//! means) and the LRQSM.
+//!
+//! PR-SSM draws: trajectory `i` uses seed [`crate::seed::prediction_seed`]`(seed, i)`, so the
+//! same seed gives the same draws whichever job predicts.
+
+use flapssm_data::{Dataset, Trajectory};
+use flapssm_prssm::train::fit::predict_raw;
+use flapssm_prssm::{PrssmModel, Sequence};
+use flapssm_qs::{InterceptMode, LrqsmModel};
+
+use crate::error::{JobError, Result};
+use crate::progress::Progress;
+use crate::seed::prediction_seed;
+
+/// PR-SSM open-loop prediction of one trajectory.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PrssmPrediction {
+    /// Output means (N, N·mm), row-major `n × 5`.
+    pub mean: Vec<f64>,
+    /// Output variances (N², (N·mm)²), `n × 5`.
+    pub var: Vec<f64>,
+    /// Latent means (standardized latent units), `n × D_x`.
+    pub latent_mean: Vec<f64>,
+}
+
+/// The raw PR-SSM sequence of a trajectory (7 inputs, 5 outputs, row-major; outputs empty for
+/// kinematics-only trajectories).
+pub fn trajectory_sequence(t: &Trajectory) -> Sequence {
+    Sequence {
+        inputs: t.inputs.as_flattened().to_vec(),
+        outputs: t
+            .outputs
+            .as_ref()
+            .map(|y| y.as_flattened().to_vec())
+            .unwrap_or_default(),
+    }
+}
+
+fn check_model_shape(model: &PrssmModel) -> Result<()> {
+    let c = &model.config;
+    if c.n_input != 7 || c.n_output != 5 {
+        return Err(JobError::Mismatch {
+            what: "PR-SSM model inputs/outputs".into(),
+            expected: "7 inputs and 5 outputs (the dataset's)".into(),
+            found: format!("{} inputs, {} outputs", c.n_input, c.n_output),
+        });
+    }
+    Ok(())
+}
+
+/// The model as it applies to `ds`'s physical units: unchanged when it carries normalization
+/// statistics; otherwise (a model trained in standardized units, e.g. the published one) a copy
+/// that standardizes with `ds`'s training statistics, as the published post-processing did.
+///
+/// # Errors
+/// [`JobError::Dataset`] when the model has no statistics and `ds` has no outputs to
+/// compute them from.
+pub fn in_dataset_units<'m>(
+    model: &'m PrssmModel,
+    ds: &Dataset,
+) -> Result<std::borrow::Cow<'m, PrssmModel>> {
+    if model.normalization.is_some() {
+        return Ok(std::borrow::Cow::Borrowed(model));
+    }
+    let s = ds.standardization()?;
+    let mut m = model.clone();
+    m.normalization = Some(flapssm_prssm::Normalization {
+        input_mean: s.mean_u.to_vec(),
+        input_std: s.std_u.to_vec(),
+        output_mean: s.mean_y.to_vec(),
+        output_std: s.std_y.to_vec(),
+    });
+    Ok(std::borrow::Cow::Owned(m))
+}
+
+/// Predicts every trajectory of `ds` with the PR-SSM (in parallel with feature `parallel`;
+/// results do not depend on threading). `progress.advance(1)` per trajectory.
+///
+/// # Errors
+/// [`JobError::Mismatch`] for a model that is not 7 → 5, [`JobError::Prssm`] naming
+/// the trajectory.
+pub fn predict_prssm(
+    model: &PrssmModel,
+    ds: &Dataset,
+    particles: usize,
+    seed: u64,
+    progress: &dyn Progress,
+) -> Result<Vec<PrssmPrediction>> {
+    check_model_shape(model)?;
+    let model = &*in_dataset_units(model, ds)?;
+    let one = |(i, t): (usize, &Trajectory)| -> Result<PrssmPrediction> {
+        let p = predict_raw(
+            model,
+            &trajectory_sequence(t),
+            particles,
+            prediction_seed(seed, i),
+        )
+        .map_err(|source| JobError::Prssm {
+            what: format!("prediction of trajectory {i}"),
+            source,
+        })?;
+        progress.advance(1);
+        Ok(PrssmPrediction {
+            mean: p.output_mean,
+            var: p.output_var,
+            latent_mean: p.latent_mean,
+        })
+    };
+    #[cfg(feature = "parallel")]
+    {
+        use rayon::prelude::*;
+        ds.trajectories.par_iter().enumerate().map(one).collect()
+    }
+    #[cfg(not(feature = "parallel"))]
+    {
+        ds.trajectories.iter().enumerate().map(one).collect()
+    }
+}
+
+/// LRQSM predictions (N, N·mm) of every trajectory, one `n × 5` table each.
+///
+/// # Errors
+/// [`JobError::Qs`] for a model that does not fit the dataset.
+pub fn predict_lrqsm(model: &LrqsmModel, ds: &Dataset) -> Result<Vec<Vec<f64>>> {
+    let p = flapssm_qs::lrqsm::predict_dataset(model, ds, InterceptMode::Fitted)?;
+    let per = p.n_samples * 5;
+    Ok(p.raw.chunks_exact(per).map(<[f64]>::to_vec).collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::progress::NoProgress;
+    use flapssm_wing::virtual_wing::{SimulationConfig, simulate_dataset};
+
+    fn tiny_dataset() -> Dataset {
+        let mut cfg = SimulationConfig::default();
+        cfg.trajectories.n_trajectories = 6;
+        cfg.trajectories.n_train = 4;
+        cfg.trajectories.seed = 3;
+        simulate_dataset(&cfg, &|| {}).unwrap()
+    }
+
+    #[test]
+    /// Regression: a model without normalization statistics (the published one works in
+    /// standardized units) used to receive raw inputs. It must predict exactly as the same
+    /// model carrying the dataset's training statistics.
+    fn a_model_without_statistics_uses_the_dataset_training_statistics() {
+        let ds = tiny_dataset();
+        let cfg = flapssm_prssm::ModelConfig::new(6, 5, 7, 4);
+        let params = flapssm_prssm::Params::init(&cfg, &Default::default(), 3);
+        let bare = PrssmModel {
+            config: cfg,
+            params,
+            normalization: None,
+            training: serde_json::Value::Null,
+        };
+        let s = ds.standardization().unwrap();
+        let mut with_stats = bare.clone();
+        with_stats.normalization = Some(flapssm_prssm::Normalization {
+            input_mean: s.mean_u.to_vec(),
+            input_std: s.std_u.to_vec(),
+            output_mean: s.mean_y.to_vec(),
+            output_std: s.std_y.to_vec(),
+        });
+        let a = predict_prssm(&bare, &ds, 3, 5, &NoProgress).unwrap();
+        let b = predict_prssm(&with_stats, &ds, 3, 5, &NoProgress).unwrap();
+        assert_eq!(a.len(), b.len());
+        for (x, y) in a.iter().zip(&b) {
+            assert_eq!(x.mean, y.mean);
+            assert_eq!(x.var, y.var);
+        }
+        // Raw inputs fed as if standardized would differ.
+        let mut raw = bare.clone();
+        raw.normalization = Some(flapssm_prssm::Normalization {
+            input_mean: vec![0.0; 7],
+            input_std: vec![1.0; 7],
+            output_mean: vec![0.0; 5],
+            output_std: vec![1.0; 5],
+        });
+        let c = predict_prssm(&raw, &ds, 3, 5, &NoProgress).unwrap();
+        assert_ne!(a[0].mean, c[0].mean);
+    }
+
+    #[test]
+    fn model_of_the_wrong_shape_is_rejected() {
+        let ds = tiny_dataset();
+        let cfg = flapssm_prssm::ModelConfig::new(4, 2, 3, 5);
+        let params = flapssm_prssm::Params::init(&cfg, &Default::default(), 1);
+        let m = PrssmModel {
+            config: cfg,
+            params,
+            normalization: None,
+            training: serde_json::Value::Null,
+        };
+        let e = predict_prssm(&m, &ds, 2, 0, &NoProgress).unwrap_err();
+        assert!(e.to_string().contains("7 inputs and 5 outputs"), "{e}");
+    }
+}
