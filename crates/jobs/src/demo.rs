@@ -277,6 +277,7 @@ pub fn run_demo(
     stop: Option<&AtomicBool>,
 ) -> Result<DemoSummary> {
     let t_all = Instant::now();
+    let plan = cfg.training.check()?;
     std::fs::create_dir_all(dir).map_err(|source| JobError::Io {
         path: dir.to_path_buf(),
         source,
@@ -357,7 +358,7 @@ pub fn run_demo(
             path: ck_path.clone(),
             source: std::io::Error::other(e.to_string()),
         })?
-        .filter(|ck| ck.config == cfg.training.spec().train);
+        .filter(|ck| ck.config == plan.spec().train);
         if !run.up_to_date("prssm", &k_pm, &[&pm_path]) {
             run.stages.stages.insert(
                 started_key.into(),
@@ -382,7 +383,7 @@ pub fn run_demo(
                 if !note.is_empty() {
                     p.println(&note);
                 }
-                let out = train_prssm(ds.train(), &cfg.training, Some(&ck_path), resume, p, stop)?;
+                let out = train_prssm(ds.train(), &plan, Some(&ck_path), resume, p, stop)?;
                 for (m, path) in [(&out.best, &pm_path), (&out.last, &last_path)] {
                     m.save(path).map_err(|source| JobError::ModelFile {
                         path: path.clone(),

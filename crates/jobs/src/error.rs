@@ -60,6 +60,16 @@ pub enum JobError {
         /// Cause.
         source: AnalysisError,
     },
+    /// A setting is out of its range; checked once, before any work.
+    #[error("setting {name} = {value}: {expected}")]
+    Setting {
+        /// The setting's name as the user gives it (`dx`, `val_fraction`, …).
+        name: String,
+        /// The value given.
+        value: String,
+        /// What it must be, and why.
+        expected: String,
+    },
     /// Shapes or settings do not fit together.
     #[error("{what}: expected {expected}, found {found}")]
     Mismatch {

@@ -155,12 +155,13 @@ pub fn sweep_run(
             value
         }
     };
+    let plan = opts.check()?;
     let train = &ds.trajectories[..used];
-    let (fit_set, val_set) = opts.split(train)?;
+    let (fit_set, val_set) = plan.split(train)?;
     let (n_fit, n_val) = (fit_set.len(), val_set.len());
     progress.start(&format!("train {} = {value}", kind.name()), 0);
     let t0 = Instant::now();
-    let out = train_prssm(train, &opts, None, None, progress, stop)?;
+    let out = train_prssm(train, &plan, None, None, progress, stop)?;
     let train_wall_s = t0.elapsed().as_secs_f64();
     progress.finish("");
 
@@ -228,7 +229,7 @@ pub fn sweep_run(
         dataset: dataset_label.into(),
         n_fit,
         n_val,
-        spec: opts.spec(),
+        spec: plan.spec().clone(),
         options: opts,
         train: train_rmse,
         test: set(used..sub.len())?,

@@ -1,10 +1,10 @@
 //! PR-SSM training on a dataset's training trajectories: the settings (a preset with overrides)
 //! and the job.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 
-use flapssm_data::Trajectory;
+use flapssm_data::{Dataset, Trajectory};
 use flapssm_prssm::Sequence;
 use flapssm_prssm::train::fit::{FitOutcome, FitSpec, Preset, fit};
 use flapssm_prssm::train::{Budget, Checkpoint, LrSchedule, TrainEvent, TrainHooks};
@@ -67,7 +67,7 @@ impl Default for TrainingOptions {
 }
 
 impl TrainingOptions {
-    /// The fit specification for 7 inputs and 5 outputs.
+    /// The fit specification for 7 inputs and 5 outputs (unchecked; [`Self::check`] checks it).
     pub fn spec(&self) -> FitSpec {
         let mut spec = FitSpec::preset(self.preset, 7, 5);
         if let Some(v) = self.dx {
@@ -103,56 +103,162 @@ impl TrainingOptions {
         spec
     }
 
+    /// Checks every setting once, before any work, and returns the validated plan.
+    ///
+    /// # Errors
+    /// [`JobError::Setting`] naming the setting in the user's words (`dx`, `particles`,
+    /// `val_fraction`, …) with the range it must be in.
+    pub fn check(&self) -> Result<TrainingPlan> {
+        let bad = |name: &str, value: String, expected: &str| {
+            Err(JobError::Setting {
+                name: name.into(),
+                value,
+                expected: expected.into(),
+            })
+        };
+        if !(0.0..1.0).contains(&self.val_fraction) {
+            return bad(
+                "val_fraction",
+                self.val_fraction.to_string(),
+                "must be in [0, 1)",
+            );
+        }
+        for (name, v) in [
+            ("dx", self.dx),
+            ("inducing", self.inducing),
+            ("particles", self.particles),
+            ("batch", self.batch),
+        ] {
+            if v == Some(0) {
+                return bad(name, "0".into(), "must be at least 1");
+            }
+        }
+        for (name, v) in [
+            ("epochs", self.epochs),
+            ("iterations", self.iterations),
+            ("eval_every", self.eval_every),
+        ] {
+            if v == Some(0) {
+                return bad(name, "0".into(), "must be at least 1");
+            }
+        }
+        let spec = self.spec();
+        let m = &spec.model;
+        if m.n_state < m.n_output {
+            return bad(
+                "dx",
+                m.n_state.to_string(),
+                &format!(
+                    "must be at least {}: the first {} latent states are the model's outputs",
+                    m.n_output, m.n_output
+                ),
+            );
+        }
+        m.check().map_err(|e| JobError::Setting {
+            name: e.field.into(),
+            value: String::new(),
+            expected: e.message,
+        })?;
+        spec.train.check().map_err(|e| JobError::Setting {
+            name: "training".into(),
+            value: String::new(),
+            expected: e.to_string(),
+        })?;
+        Ok(TrainingPlan {
+            spec,
+            val_fraction: self.val_fraction,
+        })
+    }
+}
+
+/// Training settings checked by [`TrainingOptions::check`]: the fit specification and the
+/// validation hold-out.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TrainingPlan {
+    spec: FitSpec,
+    val_fraction: f64,
+}
+
+impl TrainingPlan {
+    /// The fit specification.
+    pub fn spec(&self) -> &FitSpec {
+        &self.spec
+    }
+
+    /// Fraction of the training trajectories held out for best-model selection.
+    pub fn val_fraction(&self) -> f64 {
+        self.val_fraction
+    }
+
     /// Splits training trajectories into (fit, validation): the last
     /// `round(n · val_fraction)` (at most `n − 1`) validate.
     ///
     /// # Errors
-    /// [`JobError::Mismatch`] for a fraction outside [0, 1) or no trajectory.
+    /// [`JobError::Dataset`] when there is no training trajectory.
     pub fn split<'a>(
         &self,
         train: &'a [Trajectory],
     ) -> Result<(&'a [Trajectory], &'a [Trajectory])> {
-        if !(0.0..1.0).contains(&self.val_fraction) || train.is_empty() {
-            return Err(JobError::Mismatch {
-                what: "training split".into(),
-                expected: "val_fraction in [0, 1) and at least one training trajectory".into(),
-                found: format!("{} of {} trajectories", self.val_fraction, train.len()),
-            });
+        if train.is_empty() {
+            return Err(flapssm_data::DatasetError::NoTrainingData { n_train: 0 }.into());
         }
         let n_val =
             ((train.len() as f64 * self.val_fraction).round() as usize).min(train.len() - 1);
         Ok(train.split_at(train.len() - n_val))
     }
+
+    /// One line for `train`: the fit / validation split of `train`, sizes and budget.
+    ///
+    /// # Errors
+    /// [`JobError::Dataset`] when there is no training trajectory.
+    pub fn describe(&self, train: &[Trajectory]) -> Result<String> {
+        let (a, b) = self.split(train)?;
+        Ok(self.describe_split(a.len(), b.len()))
+    }
+
+    fn describe_split(&self, n_fit: usize, n_val: usize) -> String {
+        let s = &self.spec;
+        format!(
+            "{n_fit} training / {n_val} validation trajectories; D_x {}, M {}, {} particles, {}",
+            s.model.n_state,
+            s.model.n_inducing,
+            s.particles,
+            match s.train.budget {
+                Budget::Epochs(n) => format!("{n} epochs"),
+                Budget::Iterations(n) => format!("{n} iterations"),
+            }
+        )
+    }
 }
 
-/// Trains a PR-SSM on `train` (split by [`TrainingOptions::split`]), reporting steps to
-/// `progress` (`set(step, total)`, one line per evaluated epoch), checkpointing to
-/// `checkpoint` and resuming from `resume`. Polls `stop` before every step.
+/// Trains a PR-SSM on `train` (split by [`TrainingPlan::split`]), reporting steps to
+/// `progress` (`set(step, total)`, one line per evaluated epoch, rejected step, checkpoint),
+/// checkpointing to `checkpoint` and resuming from `resume`. Polls `stop` before every step.
 ///
 /// # Errors
-/// [`JobError::Prssm`] for a failed fit, [`JobError::Interrupted`] when stopped.
+/// [`JobError::Prssm`] for a failed fit, [`JobError::Interrupted`] when stopped (the
+/// checkpoint is written first).
 pub fn train_prssm(
     train: &[Trajectory],
-    opts: &TrainingOptions,
+    plan: &TrainingPlan,
     checkpoint: Option<&Path>,
     resume: Option<Checkpoint>,
     progress: &dyn Progress,
     stop: Option<&AtomicBool>,
 ) -> Result<FitOutcome> {
-    let (fit_set, val_set) = opts.split(train)?;
+    let (fit_set, val_set) = plan.split(train)?;
     let fit_seqs: Vec<Sequence> = fit_set.iter().map(trajectory_sequence).collect();
     let val_seqs: Vec<Sequence> = val_set.iter().map(trajectory_sequence).collect();
-    let spec = opts.spec();
     let mut on_event = |e: &TrainEvent<'_>| match e {
         TrainEvent::Step {
             step,
             total_steps,
             epoch,
             loss,
-            ..
+            lr,
         } => {
             progress.set(step + 1, *total_steps);
-            progress.message(&format!("epoch {epoch} loss {loss:.3e}"));
+            progress.message(&format!("epoch {epoch} loss {loss:.4e} lr {lr:.2e}"));
         }
         TrainEvent::Epoch(r) => {
             let f = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.4}"));
@@ -165,13 +271,23 @@ pub fn train_prssm(
                 if r.is_best { "  (best)" } else { "" }
             ));
         }
-        TrainEvent::Rejected { step, reason, .. } => {
-            progress.println(&format!("step {step} rejected ({reason}); retried"));
-        }
+        TrainEvent::Rejected {
+            step,
+            reason,
+            lr_scale,
+            retry,
+        } => progress.println(&format!(
+            "warning: step {step} rejected ({reason}); step undone, learning-rate factor now \
+             {lr_scale:.3e} (retry {retry})"
+        )),
+        TrainEvent::Interrupted { step } => progress.println(&format!(
+            "interrupted at step {step}; checkpoint {}",
+            checkpoint.map_or("(none)".into(), |p| p.display().to_string())
+        )),
         _ => {}
     };
     let out = fit(
-        &spec,
+        plan.spec(),
         &fit_seqs,
         &val_seqs,
         TrainHooks {
@@ -195,10 +311,114 @@ pub fn train_prssm(
     Ok(out)
 }
 
+/// The files of a training run: the best model, the last model and the checkpoint.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TrainFiles {
+    /// Best model (by validation RMSE, or training loss without validation).
+    pub model: PathBuf,
+    /// Model after the last step.
+    pub last: PathBuf,
+    /// Checkpoint (written every `checkpoint_every` epochs and when stopped).
+    pub checkpoint: PathBuf,
+}
+
+impl TrainFiles {
+    /// `model`, `<stem>.last.json` beside it, and `checkpoint` or `<stem>.ckpt.json`.
+    pub fn beside(model: &Path, checkpoint: Option<PathBuf>) -> Self {
+        Self {
+            model: model.to_path_buf(),
+            last: sibling(model, ".last.json"),
+            checkpoint: checkpoint.unwrap_or_else(|| sibling(model, ".ckpt.json")),
+        }
+    }
+}
+
+/// `<dir>/<stem><suffix>` next to `path`.
+fn sibling(path: &Path, suffix: &str) -> PathBuf {
+    let stem = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "model".into());
+    path.with_file_name(format!("{stem}{suffix}"))
+}
+
+/// What a finished [`train_dataset`] did.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TrainSummary {
+    /// Trajectories fitted.
+    pub n_fit: usize,
+    /// Trajectories held out for validation.
+    pub n_val: usize,
+    /// [`TrainingPlan::describe`] of the run.
+    pub description: String,
+    /// Optimizer steps done.
+    pub steps: u64,
+    /// Steps rejected (non-finite or diverging) and retried.
+    pub rejected: u64,
+    /// Epoch and score (validation RMSE, or training loss) of the best model.
+    pub best: Option<(u64, f64)>,
+}
+
+/// `flapssm train`: trains on `ds`'s training trajectories and writes the best and the last
+/// model to `files` (atomically), checkpointing to `files.checkpoint`; with `resume`, continues
+/// bit-identically from that checkpoint.
+///
+/// # Errors
+/// [`JobError::Dataset`] for a dataset without outputs or training trajectories, checkpoint and
+/// model-file errors naming the file, [`JobError::Interrupted`] when stopped.
+pub fn train_dataset(
+    ds: &Dataset,
+    plan: &TrainingPlan,
+    files: &TrainFiles,
+    resume: bool,
+    progress: &dyn Progress,
+    stop: Option<&AtomicBool>,
+) -> Result<TrainSummary> {
+    if !ds.has_outputs() {
+        return Err(flapssm_data::DatasetError::NoOutputs.into());
+    }
+    let (n_fit, n_val) = plan.split(ds.train()).map(|(a, b)| (a.len(), b.len()))?;
+    let description = plan.describe_split(n_fit, n_val);
+    let resume = if resume {
+        Some(
+            Checkpoint::load(&files.checkpoint).map_err(|e| JobError::Io {
+                path: files.checkpoint.clone(),
+                source: std::io::Error::other(format!("resuming: {e}")),
+            })?,
+        )
+    } else {
+        None
+    };
+    progress.start("train PR-SSM", 0);
+    let out = train_prssm(
+        ds.train(),
+        plan,
+        Some(&files.checkpoint),
+        resume,
+        progress,
+        stop,
+    )?;
+    for (m, path) in [(&out.best, &files.model), (&out.last, &files.last)] {
+        m.save(path).map_err(|source| JobError::ModelFile {
+            path: path.clone(),
+            source,
+        })?;
+    }
+    progress.finish(&format!("{} steps", out.outcome.state.step));
+    let state = &out.outcome.state;
+    Ok(TrainSummary {
+        n_fit,
+        n_val,
+        description,
+        steps: state.step,
+        rejected: state.rejected,
+        best: state.best.as_ref().map(|b| (b.epoch, b.score)),
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use flapssm_data::Dataset;
     use flapssm_wing::virtual_wing::{SimulationConfig, simulate_dataset};
 
     fn tiny_dataset() -> Dataset {
@@ -218,13 +438,49 @@ mod tests {
                 val_fraction: f,
                 ..TrainingOptions::default()
             };
-            o.split(t).map(|(a, b)| (a.len(), b.len()))
+            o.check()?.split(t).map(|(a, b)| (a.len(), b.len()))
         };
         assert_eq!(split(0.0).unwrap(), (5, 0));
         assert_eq!(split(0.2).unwrap(), (4, 1));
         assert_eq!(split(0.5).unwrap(), (2, 3)); // round(2.5) = 3
         assert_eq!(split(0.99).unwrap(), (1, 4)); // at least one trajectory is fitted
         assert!(split(1.0).is_err() && split(-0.1).is_err());
+    }
+
+    #[test]
+    fn check_names_the_setting_in_the_users_words() {
+        let err = |o: TrainingOptions| o.check().unwrap_err().to_string();
+        let e = err(TrainingOptions {
+            dx: Some(4),
+            ..TrainingOptions::default()
+        });
+        assert!(
+            e.contains("setting dx = 4") && e.contains("at least 5"),
+            "{e}"
+        );
+        let e = err(TrainingOptions {
+            particles: Some(0),
+            ..TrainingOptions::default()
+        });
+        assert!(e.contains("setting particles = 0"), "{e}");
+        let e = err(TrainingOptions {
+            val_fraction: 1.0,
+            ..TrainingOptions::default()
+        });
+        assert!(e.contains("setting val_fraction = 1"), "{e}");
+        let e = err(TrainingOptions {
+            lr: Some(-1.0),
+            ..TrainingOptions::default()
+        });
+        assert!(e.contains("lr"), "{e}");
+        assert!(
+            TrainingOptions {
+                dx: Some(5),
+                ..TrainingOptions::default()
+            }
+            .check()
+            .is_ok()
+        );
     }
 
     #[test]

@@ -1,18 +1,15 @@
 //! `flapssm train DATASET --out MODEL`: fit a PR-SSM to a flapssm dataset.
 
-use std::path::{Path, PathBuf};
-use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::path::PathBuf;
 
 use anyhow::{Context, bail};
 use clap::Args;
 use flapssm_data::Dataset;
-use flapssm_jobs::predict::trajectory_sequence;
-use flapssm_jobs::train::TrainingOptions;
-use flapssm_prssm::Sequence;
-use flapssm_prssm::train::fit::{Preset, fit};
-use flapssm_prssm::train::{Budget, Checkpoint, LrSchedule, TrainEvent, TrainHooks};
-use indicatif::{ProgressBar, ProgressStyle};
+use flapssm_jobs::train::{TrainFiles, TrainingOptions, train_dataset};
+use flapssm_prssm::train::LrSchedule;
+use flapssm_prssm::train::fit::Preset;
+
+use crate::progress::{Bars, stop_flag};
 
 /// Train a PR-SSM (negative-ELBO minimization with Adam).
 #[derive(Args)]
@@ -93,30 +90,10 @@ fn parse_schedule(s: &str) -> anyhow::Result<LrSchedule> {
     })
 }
 
-/// `<dir>/<stem><suffix>` next to `path`.
-fn sibling(path: &Path, suffix: &str) -> PathBuf {
-    let stem = path
-        .file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "model".into());
-    path.with_file_name(format!("{stem}{suffix}"))
-}
-
 /// Runs `flapssm train`.
 pub fn run(args: TrainArgs) -> anyhow::Result<()> {
-    let ds = Dataset::load(&args.dataset)
-        .with_context(|| format!("loading dataset {}", args.dataset.display()))?;
-    if !ds.has_outputs() {
-        bail!(
-            "{}: dataset has no outputs y to train on",
-            args.dataset.display()
-        );
-    }
-    if !(0.0..1.0).contains(&args.val_fraction) {
-        bail!("--val-fraction {} must be in [0, 1)", args.val_fraction);
-    }
     let schedule = args.schedule.as_deref().map(parse_schedule).transpose()?;
-    let options = TrainingOptions {
+    let plan = TrainingOptions {
         preset: args.preset,
         dx: args.dx,
         inducing: args.inducing,
@@ -130,132 +107,25 @@ pub fn run(args: TrainArgs) -> anyhow::Result<()> {
         seed: args.seed,
         val_fraction: args.val_fraction,
         checkpoint_every: args.checkpoint_every,
-    };
-    let (fit_part, val_part) = options
-        .split(ds.train())
-        .with_context(|| format!("{}: no training trajectories", args.dataset.display()))?;
-    let train_seqs: Vec<Sequence> = fit_part.iter().map(trajectory_sequence).collect();
-    let val_seqs: Vec<Sequence> = val_part.iter().map(trajectory_sequence).collect();
-    let spec = options.spec();
-
-    let ck_path = args
-        .checkpoint
-        .clone()
-        .unwrap_or_else(|| sibling(&args.out, ".ckpt.json"));
-    let resume = if args.resume {
-        Some(
-            Checkpoint::load(&ck_path)
-                .with_context(|| format!("resuming from {}", ck_path.display()))?,
-        )
-    } else {
-        None
-    };
-
-    let stop = Arc::new(AtomicBool::new(false));
-    {
-        let stop = Arc::clone(&stop);
-        ctrlc::set_handler(move || stop.store(true, Ordering::SeqCst))
-            .context("installing the Ctrl-C handler")?;
     }
-    let bar = ProgressBar::new(0);
-    bar.set_style(
-        ProgressStyle::with_template(
-            "{elapsed_precise} [{bar:30}] {pos}/{len} steps (eta {eta}) {msg}",
-        )
-        .context("progress bar template")?
-        .progress_chars("=> "),
-    );
-    let say = |line: String| bar.suspend(|| eprintln!("{line}"));
-    let mut progress = |e: &TrainEvent<'_>| match e {
-        TrainEvent::Step {
-            step,
-            total_steps,
-            epoch,
-            loss,
-            lr,
-        } => {
-            bar.set_length(*total_steps);
-            bar.set_position(step + 1);
-            bar.set_message(format!("epoch {epoch} loss {loss:.4e} lr {lr:.2e}"));
-        }
-        TrainEvent::Epoch(r) => {
-            let f = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.4}"));
-            say(format!(
-                "epoch {:>4}: -ELBO {:.5e}  train RMSE {}  val RMSE {}{}",
-                r.epoch,
-                r.mean_loss,
-                f(r.train_rmse),
-                f(r.val_rmse),
-                if r.is_best { "  (best)" } else { "" }
-            ));
-        }
-        TrainEvent::Rejected {
-            step,
-            reason,
-            lr_scale,
-            retry,
-        } => say(format!(
-            "warning: step {step} rejected ({reason}); step undone, learning-rate factor now {lr_scale:.3e} (retry {retry})"
-        )),
-        TrainEvent::Checkpoint { path, step } => {
-            say(format!("checkpoint at step {step} -> {}", path.display()))
-        }
-        TrainEvent::Interrupted { step } => say(format!(
-            "interrupted at step {step}; continue with --resume (checkpoint {})",
-            ck_path.display()
-        )),
-        _ => {}
-    };
-    println!(
-        "{}: {} training / {} validation trajectories; D_x {}, M {}, {} particles, {}",
-        args.dataset.display(),
-        train_seqs.len(),
-        val_seqs.len(),
-        spec.model.n_state,
-        spec.model.n_inducing,
-        spec.particles,
-        match spec.train.budget {
-            Budget::Epochs(n) => format!("{n} epochs"),
-            Budget::Iterations(n) => format!("{n} iterations"),
-        }
-    );
-    let out = fit(
-        &spec,
-        &train_seqs,
-        &val_seqs,
-        TrainHooks {
-            evaluate: None,
-            progress: Some(&mut progress),
-            stop: Some(&stop),
-            checkpoint: Some(ck_path.clone()),
-        },
-        resume,
-    )
-    .with_context(|| format!("training on {}", args.dataset.display()))?;
-    bar.finish_and_clear();
-    if out.outcome.interrupted {
-        bail!(
-            "interrupted at step {}; resumable checkpoint {}",
-            out.outcome.state.step,
-            ck_path.display()
-        );
+    .check()?;
+    let ds = Dataset::load(&args.dataset)
+        .with_context(|| format!("loading dataset {}", args.dataset.display()))?;
+    if ds.has_outputs() {
+        println!("{}: {}", args.dataset.display(), plan.describe(ds.train())?);
     }
-    let last_path = sibling(&args.out, ".last.json");
-    out.best
-        .save(&args.out)
-        .with_context(|| format!("writing model {}", args.out.display()))?;
-    out.last
-        .save(&last_path)
-        .with_context(|| format!("writing model {}", last_path.display()))?;
-    let best = out.outcome.state.best.as_ref();
+    let files = TrainFiles::beside(&args.out, args.checkpoint.clone());
+    let stop = stop_flag()?;
+    let s = train_dataset(&ds, &plan, &files, args.resume, &Bars::new(), Some(&stop))
+        .with_context(|| format!("training on {}", args.dataset.display()))?;
     println!(
         "{} steps ({} rejected); best model (epoch {}, score {}) -> {}; last -> {}",
-        out.outcome.state.step,
-        out.outcome.state.rejected,
-        best.map_or("-".into(), |b| b.epoch.to_string()),
-        best.map_or("-".into(), |b| format!("{:.4}", b.score)),
-        args.out.display(),
-        last_path.display()
+        s.steps,
+        s.rejected,
+        s.best.map_or("-".into(), |b| b.0.to_string()),
+        s.best.map_or("-".into(), |b| format!("{:.4}", b.1)),
+        files.model.display(),
+        files.last.display()
     );
     Ok(())
 }

@@ -601,7 +601,8 @@ mod tests {
             val_fraction: 0.0,
             ..TrainingOptions::default()
         };
-        let fit = train_prssm(ds.train(), &opts, None, None, &NoProgress, None).unwrap();
+        let plan = opts.check().unwrap();
+        let fit = train_prssm(ds.train(), &plan, None, None, &NoProgress, None).unwrap();
         let dir = std::env::temp_dir().join(format!("flapssm-pipeline-{}", std::process::id()));
         let eo = EvalOptions {
             start_sample: 0,
