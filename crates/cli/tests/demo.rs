@@ -115,6 +115,26 @@ fn tiny_demo_evaluate_and_sweep() {
     assert_eq!(m2["prssm"], m["prssm"]);
     assert_eq!(m2["lrqsm"], m["lrqsm"]);
 
+    // `predict` with the same seed draws what `evaluate` and the demo drew (one seed rule).
+    let pred = tmp.path().join("pred.npz");
+    ok(&[
+        "predict",
+        dir.join("prssm.json").to_str().unwrap(),
+        dir.join("dataset.npz").to_str().unwrap(),
+        "--seed",
+        "5",
+        "--out",
+        pred.to_str().unwrap(),
+    ]);
+    let array = |path: &std::path::Path, name: &str| -> Vec<f64> {
+        let mut r = flapssm_data::npz::NpzReader::open(path).unwrap();
+        r.f64(name).unwrap().data
+    };
+    for demo_eval in [&eval, &ev] {
+        let evaluated = array(&demo_eval.join("predictions.npz"), "prssm_mean");
+        assert_eq!(array(&pred, "output_mean"), evaluated);
+    }
+
     // Sweeps: one process per configuration, then merge.
     let ds = dir.join("dataset.npz");
     let mut results = Vec::new();

@@ -70,7 +70,11 @@ pub fn run(args: PredictArgs) -> anyhow::Result<()> {
         .flat_map(|t| table.columns.iter().map(move |c| c[t]))
         .collect();
     let pred = model
-        .predict_inputs(&inputs, args.particles, args.seed)
+        .predict_inputs(
+            &inputs,
+            args.particles,
+            flapssm_jobs::seed::prediction_seed(args.seed, 0),
+        )
         .with_context(|| format!("predicting with {}", args.model.display()))?;
     pred.write_csv(&args.out, model.config.n_output)
         .with_context(|| format!("writing {}", args.out.display()))?;
@@ -140,7 +144,7 @@ fn run_dataset(args: PredictArgs) -> anyhow::Result<()> {
                 &model,
                 &seq,
                 args.particles,
-                args.seed.wrapping_add(i as u64),
+                flapssm_jobs::seed::prediction_seed(args.seed, i),
             )
             .with_context(|| format!("{}: trajectory {i}", ds_path.display()));
             bar.inc(1);
