@@ -103,16 +103,3 @@ pub fn stop_flag() -> anyhow::Result<Arc<AtomicBool>> {
         .context("installing the Ctrl-C handler")?;
     Ok(stop)
 }
-
-/// A progress bar on stderr for `len` items (drawn only when stderr is a terminal).
-pub fn progress_bar(len: u64, items: &str) -> anyhow::Result<ProgressBar> {
-    let bar = ProgressBar::new(len);
-    bar.set_style(
-        ProgressStyle::with_template(&format!(
-            "{{elapsed_precise}} [{{bar:30}}] {{pos}}/{{len}} {items} (eta {{eta}})"
-        ))
-        .context("progress bar template")?
-        .progress_chars("=> "),
-    );
-    Ok(bar)
-}

@@ -4,8 +4,14 @@
 //! PR-SSM draws: trajectory `i` uses seed [`crate::seed::prediction_seed`]`(seed, i)`, so the
 //! same seed gives the same draws whichever job predicts.
 
+use std::path::Path;
+
+use flapssm_data::npz::{NpyData, NpzWriter};
 use flapssm_data::{Dataset, Trajectory};
+use flapssm_prssm::predict::Prediction;
+use flapssm_prssm::train::InitialStateSpec;
 use flapssm_prssm::train::fit::predict_raw;
+use flapssm_prssm::train::fit::training_record;
 use flapssm_prssm::{PrssmModel, Sequence};
 use flapssm_qs::{InterceptMode, LrqsmModel};
 
@@ -13,16 +19,10 @@ use crate::error::{JobError, Result};
 use crate::progress::Progress;
 use crate::seed::prediction_seed;
 
-/// PR-SSM open-loop prediction of one trajectory.
-#[derive(Debug, Clone, PartialEq)]
-pub struct PrssmPrediction {
-    /// Output means (N, N·mm), row-major `n × 5`.
-    pub mean: Vec<f64>,
-    /// Output variances (N², (N·mm)²), `n × 5`.
-    pub var: Vec<f64>,
-    /// Latent means (standardized latent units), `n × D_x`.
-    pub latent_mean: Vec<f64>,
-}
+/// PR-SSM open-loop prediction of one trajectory: output means (N, N·mm) and variances
+/// (N², (N·mm)²), row-major `n × 5`; latent means and variances (standardized latent units),
+/// `n × D_x`.
+pub type PrssmPrediction = Prediction;
 
 /// The raw PR-SSM sequence of a trajectory (7 inputs, 5 outputs, row-major; outputs empty for
 /// kinematics-only trajectories).
@@ -101,11 +101,7 @@ pub fn predict_prssm(
             source,
         })?;
         progress.advance(1);
-        Ok(PrssmPrediction {
-            mean: p.output_mean,
-            var: p.output_var,
-            latent_mean: p.latent_mean,
-        })
+        Ok(p)
     };
     #[cfg(feature = "parallel")]
     {
@@ -126,6 +122,141 @@ pub fn predict_lrqsm(model: &LrqsmModel, ds: &Dataset) -> Result<Vec<Vec<f64>>> 
     let p = flapssm_qs::lrqsm::predict_dataset(model, ds, InterceptMode::Fitted)?;
     let per = p.n_samples * 5;
     Ok(p.raw.chunks_exact(per).map(<[f64]>::to_vec).collect())
+}
+
+/// What [`predict_dataset_file`] did.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DatasetPredictionSummary {
+    /// Trajectories predicted.
+    pub n_trajectories: usize,
+    /// Samples per trajectory.
+    pub n_samples: usize,
+    /// Notes for the user (e.g. whose statistics standardized the data).
+    pub notes: Vec<String>,
+}
+
+/// `flapssm predict MODEL DATASET`: predicts every trajectory of `ds` ([`predict_prssm`]) and
+/// writes `out` (.npz, atomically): `output_mean`, `output_var` (`n_traj × T × 5`, N and N·mm),
+/// `latent_mean`, `latent_var` (`n_traj × T × D_x`, standardized), `is_train` (`n_traj`) and
+/// `y` (the dataset's outputs, when it has them). A model without normalization statistics (the
+/// published one) works in standardized units: `ds`'s training statistics are used, and a
+/// note says so.
+///
+/// # Errors
+/// A model that is not 7 → 5, one without statistics on a dataset without outputs, prediction
+/// and file errors naming the trajectory or file.
+pub fn predict_dataset_file(
+    model: &PrssmModel,
+    ds: &Dataset,
+    particles: usize,
+    seed: u64,
+    out: &Path,
+    progress: &dyn Progress,
+) -> Result<DatasetPredictionSummary> {
+    check_model_shape(model)?;
+    let mut notes = Vec::new();
+    if model.normalization.is_none() {
+        if !ds.has_outputs() {
+            return Err(JobError::Mismatch {
+                what: "PR-SSM model without normalization statistics".into(),
+                expected: "a dataset with outputs to standardize with".into(),
+                found: "a dataset with no outputs".into(),
+            });
+        }
+        notes.push(
+            "the model has no normalization statistics; standardizing with the dataset's \
+             training statistics"
+                .into(),
+        );
+    }
+    let (n, t_n, dx) = (ds.len(), ds.n_samples(), model.config.n_state);
+    progress.start("predict", n as u64);
+    let preds = predict_prssm(model, ds, particles, seed, progress)?;
+    progress.finish("");
+    let cat =
+        |f: fn(&Prediction) -> &[f64]| NpyData::F64(preds.iter().flat_map(f).copied().collect());
+    let mut w = NpzWriter::new();
+    w.add("output_mean", &[n, t_n, 5], cat(|p| &p.output_mean))
+        .add("output_var", &[n, t_n, 5], cat(|p| &p.output_var))
+        .add("latent_mean", &[n, t_n, dx], cat(|p| &p.latent_mean))
+        .add("latent_var", &[n, t_n, dx], cat(|p| &p.latent_var))
+        .add(
+            "is_train",
+            &[n],
+            NpyData::Bool((0..n).map(|i| i < ds.n_train).collect()),
+        );
+    if ds.has_outputs() {
+        let y: Vec<f64> = ds
+            .trajectories
+            .iter()
+            .flat_map(|t| t.outputs.as_deref().unwrap_or_default().as_flattened())
+            .copied()
+            .collect();
+        w.add("y", &[n, t_n, 5], NpyData::F64(y));
+    }
+    w.save(out).map_err(|e| JobError::Io {
+        path: out.to_path_buf(),
+        source: std::io::Error::other(e.to_string()),
+    })?;
+    Ok(DatasetPredictionSummary {
+        n_trajectories: n,
+        n_samples: t_n,
+        notes,
+    })
+}
+
+/// A prediction from an input table, with notes for the user.
+#[derive(Debug, Clone, PartialEq)]
+pub struct InputsPrediction {
+    /// Output and latent moments (outputs in the model's units).
+    pub prediction: Prediction,
+    /// Notes (e.g. an initial-state rule that the inputs alone cannot apply).
+    pub notes: Vec<String>,
+}
+
+/// `flapssm predict MODEL --inputs U.csv`: open-loop prediction from `inputs` (row-major
+/// `T × n_columns`, physical units when the model has normalization statistics, else
+/// standardized) with draws seeded by [`prediction_seed`]`(seed, 0)`, from `x₀ = 0`.
+///
+/// # Errors
+/// [`JobError::Mismatch`] when `n_columns` is not the model's input count; prediction errors.
+pub fn predict_inputs(
+    model: &PrssmModel,
+    inputs: &[f64],
+    n_columns: usize,
+    particles: usize,
+    seed: u64,
+) -> Result<InputsPrediction> {
+    let du = model.config.n_input;
+    if n_columns != du {
+        return Err(JobError::Mismatch {
+            what: "input columns".into(),
+            expected: format!("the model's D_u = {du} inputs"),
+            found: format!("{n_columns} columns"),
+        });
+    }
+    let mut notes = Vec::new();
+    if let Ok(r) = training_record(model) {
+        let rule = match r.initial_state.spec {
+            InitialStateSpec::Zeros => None,
+            InitialStateSpec::Outputs => Some("outputs"),
+            _ => Some("recognition"),
+        };
+        if let Some(rule) = rule {
+            notes.push(format!(
+                "the model was trained with the '{rule}' initial-state rule, which needs the \
+                 first outputs; inputs alone are predicted from x_0 = 0 (predict a dataset to \
+                 apply it)"
+            ));
+        }
+    }
+    let prediction = model
+        .predict_inputs(inputs, particles, prediction_seed(seed, 0))
+        .map_err(|e| JobError::Prssm {
+            what: "prediction".into(),
+            source: e.into(),
+        })?;
+    Ok(InputsPrediction { prediction, notes })
 }
 
 #[cfg(test)]
@@ -168,8 +299,8 @@ mod tests {
         let b = predict_prssm(&with_stats, &ds, 3, 5, &NoProgress).unwrap();
         assert_eq!(a.len(), b.len());
         for (x, y) in a.iter().zip(&b) {
-            assert_eq!(x.mean, y.mean);
-            assert_eq!(x.var, y.var);
+            assert_eq!(x.output_mean, y.output_mean);
+            assert_eq!(x.output_var, y.output_var);
         }
         // Raw inputs fed as if standardized would differ.
         let mut raw = bare.clone();
@@ -180,7 +311,7 @@ mod tests {
             output_std: vec![1.0; 5],
         });
         let c = predict_prssm(&raw, &ds, 3, 5, &NoProgress).unwrap();
-        assert_ne!(a[0].mean, c[0].mean);
+        assert_ne!(a[0].output_mean, c[0].output_mean);
     }
 
     #[test]

@@ -187,7 +187,7 @@ pub fn sweep_run(
         .iter()
         .map(|t| z(t.outputs.as_deref().unwrap_or_default().as_flattened()))
         .collect();
-    let predz: Vec<Vec<f64>> = pred.iter().map(|p| z(&p.mean)).collect();
+    let predz: Vec<Vec<f64>> = pred.iter().map(|p| z(&p.output_mean)).collect();
     let set = |r: std::ops::Range<usize>| -> Result<Option<SetRmse>> {
         if r.is_empty() {
             return Ok(None);

@@ -277,13 +277,13 @@ pub fn evaluate(
         let coef = |v: &[f64]| -> Result<Vec<f64>> {
             coefficients_of(rows(v, 5, &what)?, &scales).map_err(analysis(what.clone()))
         };
-        let std_raw: Vec<f64> = pp[i].var.iter().map(|v| v.max(0.0).sqrt()).collect();
+        let std_raw: Vec<f64> = pp[i].output_var.iter().map(|v| v.max(0.0).sqrt()).collect();
         prep.push(Prepared {
             window,
             measured_z: z(measured),
             measured_c: coef(measured)?,
-            prssm_z: z(&pp[i].mean),
-            prssm_c: coef(&pp[i].mean)?,
+            prssm_z: z(&pp[i].output_mean),
+            prssm_c: coef(&pp[i].output_mean)?,
             prssm_std_c: coef(&std_raw)?,
             lrqsm_z: z(&lq[i]),
             lrqsm_c: coef(&lq[i])?,

@@ -46,12 +46,12 @@ pub(super) fn write_predictions(
     w.add(
         "prssm_mean",
         &[k, n, 5],
-        cat(pp.iter().map(|p| p.mean.as_slice()).collect()),
+        cat(pp.iter().map(|p| p.output_mean.as_slice()).collect()),
     )
     .add(
         "prssm_var",
         &[k, n, 5],
-        cat(pp.iter().map(|p| p.var.as_slice()).collect()),
+        cat(pp.iter().map(|p| p.output_var.as_slice()).collect()),
     )
     .add(
         "prssm_latent_mean",
