@@ -10,6 +10,10 @@ mod progress;
 #[derive(Parser)]
 #[command(name = "flapssm", version, about, long_about = None)]
 struct Cli {
+    /// Threads of the pool every parallel loop runs on (default: RAYON_NUM_THREADS, else one
+    /// per core). Results do not depend on it.
+    #[arg(long, global = true, value_parser = cmd::positive::<usize>)]
+    threads: Option<usize>,
     #[command(subcommand)]
     command: Command,
 }
@@ -63,7 +67,18 @@ fn restore_sigpipe() {
 fn main() {
     restore_sigpipe();
     let cli = Cli::parse();
-    let result = match cli.command {
+    let result = flapssm_jobs::threads::run_with_threads(cli.threads, || run(cli.command))
+        .map_err(anyhow::Error::from)
+        .and_then(|r| r);
+    if let Err(err) = result {
+        eprintln!("error: {}", cmd::error_message(&err));
+        std::process::exit(1);
+    }
+}
+
+/// Runs one subcommand.
+fn run(command: Command) -> anyhow::Result<()> {
+    match command {
         Command::Version => cmd::version(),
         Command::Dataset(args) => cmd::dataset::run(args),
         Command::Model(args) => cmd::model::run(args),
@@ -77,9 +92,5 @@ fn main() {
         Command::Sweep { command } => cmd::sweep::run(command),
         Command::Demo(args) => cmd::demo::run(args),
         Command::Sysid(args) => cmd::sysid::run(args),
-    };
-    if let Err(err) = result {
-        eprintln!("error: {}", cmd::error_message(&err));
-        std::process::exit(1);
     }
 }

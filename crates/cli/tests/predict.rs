@@ -120,6 +120,17 @@ fn published_model_on_a_dataset_writes_the_documented_arrays() {
             "{threads} threads differ"
         );
     }
+    // The --threads flag sizes the pool explicitly: same bytes.
+    for threads in ["1", "3"] {
+        let again = dir.path().join(format!("flag{threads}.npz"));
+        let mut a = args;
+        a[7] = s(&again);
+        ok(&[&["--threads", threads, "predict"], &a[..]].concat());
+        assert!(
+            std::fs::read(&again).unwrap() == bytes,
+            "--threads {threads} differs"
+        );
+    }
     let other = dir.path().join("other.npz");
     let mut a = args;
     a[5] = "5";

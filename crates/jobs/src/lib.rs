@@ -10,15 +10,17 @@
 //! | [`evaluate`] | both models on a dataset: metrics, authority, figures, report |
 //! | [`sweep`] | one-configuration PR-SSM sweep runs (D_x, training-set size) and their merge |
 //! | [`demo`] | the one-command demo: simulate, fit, train, evaluate (resumable) |
+//! | [`bench`] | the engine's speed in the paper's configuration beside the authors' code |
 //! | [`sysid`] | Doerr et al. system-identification protocol (fit, open-loop test, RMSE/NLL) |
 //!
 //! Shared pieces: [`error`] (one error type naming the file, trajectory or stage), [`progress`]
 //! (the progress sink a caller supplies), [`seed`] (the one seed-derivation rule), [`files`]
-//! (atomic JSON and text files).
+//! (atomic JSON and text files), [`threads`] (the pool a job runs on).
 //!
 //! Features: `parallel` (default) predicts trajectories and runs restarts on rayon.
 #![warn(missing_docs)]
 
+pub mod bench;
 pub mod demo;
 pub mod error;
 pub mod evaluate;
@@ -28,6 +30,7 @@ pub mod progress;
 pub mod seed;
 pub mod sweep;
 pub mod sysid;
+pub mod threads;
 pub mod train;
 
 pub use error::{JobError, Result};

@@ -7,12 +7,16 @@ use criterion::{BenchmarkId, Criterion, black_box, criterion_group, criterion_ma
 use flapssm_prssm::Objective;
 use flapssm_prssm::stream::StreamPredictor;
 use flapssm_prssm::train::Adam;
-use flapssm_prssm::train::bench::{paper_model, paper_objective, time_batches, time_prediction};
+use flapssm_prssm::train::bench::{
+    initial_model, synthetic_objective, time_batches, time_prediction,
+};
+use flapssm_prssm::train::fit::{FitSpec, Preset};
 
 fn benches(c: &mut Criterion) {
     let mut g = c.benchmark_group("train");
     g.sample_size(10);
-    let (elbo, params) = paper_objective(16, 470, 0).unwrap();
+    let spec = FitSpec::preset(Preset::Paper, 7, 5);
+    let (elbo, params) = synthetic_objective(&spec, 16, 470, 0).unwrap();
     g.bench_with_input(
         BenchmarkId::new("paper_minibatch_16x470x30", 16),
         &16,
@@ -30,7 +34,7 @@ fn benches(c: &mut Criterion) {
             })
         },
     );
-    let model = paper_model(0);
+    let model = initial_model(&spec, 0);
     g.bench_with_input(BenchmarkId::new("predict_470x30", 470), &470, |b, _| {
         b.iter(|| time_prediction(&model, 470, 30, 1).unwrap())
     });

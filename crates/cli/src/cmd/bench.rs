@@ -3,14 +3,10 @@
 
 use anyhow::Context;
 use clap::Args;
-use flapssm_prssm::train::bench::{
-    AUTHORS_EPOCH_S, AUTHORS_PREDICT_S, REFERENCE_SOLVE_S, gemm_rate_gflops, paper_model,
-    paper_objective, predict_step_flops, reference_solve_seconds, time_batches, time_prediction,
-    time_stream_step,
+use flapssm_jobs::bench::{
+    AUTHORS_EPOCH_S, AUTHORS_PREDICT_S, BenchSettings, bench, speed_against_reference_machine,
 };
-
-/// Steps of the timed prediction (the authors' trajectory length).
-const PREDICT_STEPS: usize = 470;
+use flapssm_prssm::train::bench::REFERENCE_SOLVE_S;
 
 /// Measure training, prediction and streaming speed (release build, this machine).
 #[derive(Args)]
@@ -28,57 +24,53 @@ pub struct BenchArgs {
 
 /// Runs `flapssm bench`.
 pub fn run(args: BenchArgs) -> anyhow::Result<()> {
-    let threads = rayon::current_num_threads();
-    let gemm = gemm_rate_gflops(512, 0.3);
-    println!("this machine: f64 GEMM (512 x 512 x 512, faer, 1 thread) {gemm:.1} GFLOP/s per core");
-    let solve = reference_solve_seconds(0.2);
+    let r = bench(&BenchSettings {
+        batches: usize::from(args.batches),
+        reps: args.reps,
+        seed: args.seed,
+    })
+    .context("flapssm bench")?;
+    let threads = r.threads;
+    println!(
+        "this machine: f64 GEMM (512 x 512 x 512, faer, 1 thread) {:.1} GFLOP/s per core",
+        r.gemm_gflops
+    );
     println!(
         "  faer triangular solve (100 x 100, 480 right-hand sides, 1 thread): {:.1} us; \
          ~{:.0} us on the machine of the authors' timings (prssm-notes 4): x{:.2} its speed",
-        solve * 1e6,
+        r.reference_solve_s * 1e6,
         REFERENCE_SOLVE_S * 1e6,
-        REFERENCE_SOLVE_S / solve
-    );
-    let (elbo, params) =
-        paper_objective(512, 470, args.seed).context("building the paper objective")?;
-    let n_batches = usize::from(args.batches);
-    let times =
-        time_batches(&elbo, &params, n_batches, args.seed).context("timing training batches")?;
-    let (secs, flop) = (times.total_s, times.flop);
-    let epoch_s = secs * 32.0 / n_batches as f64;
-    let rate = flop / secs / 1e9;
-    let limit = threads as f64 * gemm;
-    println!(
-        "training epoch (512 seq x 470 steps x 30 particles, batch 16, {threads} threads): {epoch_s:.3} s \
-         ({n_batches} batches timed), {:.1}x faster than the authors' {AUTHORS_EPOCH_S} s",
-        AUTHORS_EPOCH_S / epoch_s
+        speed_against_reference_machine(&r)
     );
     println!(
-        "  {rate:.1} GFLOP/s = {:.0} % of {threads} x the GEMM rate; all FLOP at that rate: {:.2} s per epoch",
-        100.0 * rate / limit,
-        epoch_s * rate / limit
+        "training epoch (512 seq x 470 steps x 30 particles, batch 16, {threads} threads): {:.3} s \
+         ({} batches timed), {:.1}x faster than the authors' {AUTHORS_EPOCH_S} s",
+        r.epoch_s,
+        r.batches,
+        AUTHORS_EPOCH_S / r.epoch_s
+    );
+    println!(
+        "  {:.1} GFLOP/s = {:.0} % of {threads} x the GEMM rate; all FLOP at that rate: {:.2} s per epoch",
+        r.train_gflops,
+        100.0 * r.train_gflops / (threads as f64 * r.gemm_gflops),
+        r.flop_limit_epoch_s()
     );
     println!(
         "  fastest minibatch x 32: {:.3} s (the epoch above includes any outside load on this machine)",
-        times.fastest_s * 32.0
+        r.fastest_epoch_s
     );
-    let model = paper_model(args.seed);
-    let pred_s =
-        time_prediction(&model, PREDICT_STEPS, 30, args.reps).context("timing prediction")?;
-    let transitions = (PREDICT_STEPS - 1) as f64;
-    let pred_rate = transitions * predict_step_flops(&model.config, 30) / pred_s / 1e9;
     println!(
-        "prediction (470 steps x 30 particles, 1 thread): {:.3} ms, {pred_rate:.1} GFLOP/s ({:.0} % of the GEMM rate), \
+        "prediction (470 steps x 30 particles, 1 thread): {:.3} ms, {:.1} GFLOP/s ({:.0} % of the GEMM rate), \
          {:.1}x faster than the authors' {AUTHORS_PREDICT_S} s",
-        pred_s * 1e3,
-        100.0 * pred_rate / gemm,
-        AUTHORS_PREDICT_S / pred_s
+        r.predict_s * 1e3,
+        r.predict_gflops,
+        100.0 * r.predict_gflops / r.gemm_gflops,
+        AUTHORS_PREDICT_S / r.predict_s
     );
-    let step_s = time_stream_step(&model, 30, 2000).context("timing streaming")?;
     println!(
         "streaming step (30 particles): {:.1} us, {:.1} GFLOP/s",
-        step_s * 1e6,
-        predict_step_flops(&model.config, 30) / step_s / 1e9
+        r.stream_step_s * 1e6,
+        r.stream_gflops
     );
     Ok(())
 }

@@ -1,6 +1,6 @@
-//! Speed measurements of the paper's configuration (used by `flapssm bench` and the
-//! criterion benches), on synthetic data of the paper's shapes, with the FLOP model that
-//! turns times into GFLOP/s and the machine's own GEMM rate that bounds them.
+//! Speed measurements of a fit specification (used by `flapssm bench`, which picks the paper's,
+//! and the criterion benches), on synthetic data of its shapes, with the FLOP model that turns
+//! times into GFLOP/s and the machine's own GEMM rate that bounds them.
 
 use std::time::Instant;
 
@@ -9,7 +9,7 @@ use faer::linalg::triangular_solve::solve_lower_triangular_in_place;
 use faer::{Accum, Mat, Par};
 
 use super::batches::{BatchPlan, WindowSpec, derive_seed};
-use super::fit::{FitSpec, Preset};
+use super::fit::FitSpec;
 use crate::elbo::{Elbo, ElboError, ElboOptions, Sequence, TrainingData};
 use crate::model::PrssmModel;
 use crate::params::{ModelConfig, Params};
@@ -17,11 +17,6 @@ use crate::predict;
 use crate::stream::StreamPredictor;
 use crate::systems::random_input;
 use crate::{Objective, ObjectiveError, Window};
-
-/// The authors' code: one training epoch (s), prssm-notes §3.
-pub const AUTHORS_EPOCH_S: f64 = 81.8;
-/// The authors' code: prediction of one 470-step trajectory with 30 particles (s).
-pub const AUTHORS_PREDICT_S: f64 = 0.152;
 
 /// FLOP of one training transition step (forward + backward) of `n_points`
 /// particle-windows, dominant terms: the three `M × M × N` products `W = G K`, `Y = Gᵀ W̄`
@@ -131,9 +126,15 @@ fn reference_system() -> (Mat<f64>, Mat<f64>) {
     (l, b)
 }
 
-/// `n` synthetic sequences of `len` steps with 7 smooth random inputs and 5 outputs
-/// (standardized scale), seeded.
-pub fn synthetic_sequences(n: usize, len: usize, seed: u64) -> Vec<Sequence> {
+/// `n` synthetic sequences of `len` steps with `n_input` smooth random inputs and `n_output`
+/// outputs (standardized scale), seeded.
+pub fn synthetic_sequences(
+    n: usize,
+    len: usize,
+    n_input: usize,
+    n_output: usize,
+    seed: u64,
+) -> Vec<Sequence> {
     (0..n)
         .map(|i| {
             let chans = |d: usize, stream: u64| -> Vec<Vec<f64>> {
@@ -143,7 +144,7 @@ pub fn synthetic_sequences(n: usize, len: usize, seed: u64) -> Vec<Sequence> {
                     })
                     .collect()
             };
-            let (u, y) = (chans(7, 10), chans(5, 11));
+            let (u, y) = (chans(n_input, 10), chans(n_output, 11));
             Sequence {
                 inputs: (0..len).flat_map(|t| u.iter().map(move |c| c[t])).collect(),
                 outputs: (0..len).flat_map(|t| y.iter().map(move |c| c[t])).collect(),
@@ -152,19 +153,25 @@ pub fn synthetic_sequences(n: usize, len: usize, seed: u64) -> Vec<Sequence> {
         .collect()
 }
 
-/// The paper's ELBO (D_x 12, M 100, Matern-3/2, 30 particles, 20 % burn-in) on
+/// The ELBO of `spec` (its model, particles and burn-in, the standard minibatch scaling) on
 /// `n_sequences` synthetic sequences of `len` steps, with its initial parameters.
 ///
 /// # Errors
-/// [`ElboError`] (not expected for these shapes).
-pub fn paper_objective(
+/// [`ElboError`] for a specification that does not fit the shapes.
+pub fn synthetic_objective(
+    spec: &FitSpec,
     n_sequences: usize,
     len: usize,
     seed: u64,
 ) -> Result<(Elbo, Vec<f64>), ElboError> {
-    let spec = FitSpec::preset(Preset::Paper, 7, 5);
-    let data = TrainingData::new(7, 5, synthetic_sequences(n_sequences, len, seed))?;
-    let elbo = Elbo::new(spec.model.clone(), data, ElboOptions::paper(n_sequences))?;
+    let (du, dy) = (spec.model.n_input, spec.model.n_output);
+    let data = TrainingData::new(du, dy, synthetic_sequences(n_sequences, len, du, dy, seed))?;
+    let options = ElboOptions {
+        particles: spec.particles,
+        burn_in_fraction: spec.burn_in_fraction,
+        ..ElboOptions::paper(n_sequences)
+    };
+    let elbo = Elbo::new(spec.model.clone(), data, options)?;
     let params = Params::init(&spec.model, &spec.init, seed).unconstrained(&spec.model);
     Ok((elbo, params))
 }
@@ -221,9 +228,9 @@ pub fn time_batches(
     })
 }
 
-/// A paper-shaped model (fresh parameters) for prediction timings.
-pub fn paper_model(seed: u64) -> PrssmModel {
-    let spec = FitSpec::preset(Preset::Paper, 7, 5);
+/// A model of `spec`'s shapes (fresh parameters) for prediction timings.
+pub fn initial_model(spec: &FitSpec, seed: u64) -> PrssmModel {
+    let spec = spec.clone();
     PrssmModel {
         params: Params::init(&spec.model, &spec.init, seed),
         config: spec.model,
@@ -243,7 +250,8 @@ pub fn time_prediction(
     particles: usize,
     reps: usize,
 ) -> Result<f64, ObjectiveError> {
-    let seq = &synthetic_sequences(1, len, 5)[0];
+    let (du, dy) = (model.config.n_input, model.config.n_output);
+    let seq = &synthetic_sequences(1, len, du, dy, 5)[0];
     let zero = vec![0.0; model.config.n_state];
     let mut times = Vec::with_capacity(reps);
     for r in 0..reps.max(1) {
@@ -273,7 +281,8 @@ pub fn time_stream_step(
     particles: usize,
     steps: usize,
 ) -> Result<f64, ObjectiveError> {
-    let seq = &synthetic_sequences(1, steps.max(1), 6)[0];
+    let (du, dy) = (model.config.n_input, model.config.n_output);
+    let seq = &synthetic_sequences(1, steps.max(1), du, dy, 6)[0];
     let zero = vec![0.0; model.config.n_state];
     let mut s = StreamPredictor::new(model, particles, &zero, &zero, 1)?;
     let du = model.config.n_input;
@@ -289,6 +298,7 @@ pub fn time_stream_step(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::train::fit::Preset;
 
     /// The FLOP model against a hand count for the paper's shapes (M 100, D 19, D_x 12):
     /// `6·100²·480 + 6·100·19·480 + 12·100·12·480` and `2·112·100·30 + 2·12·100·30 + 2·100·12·30`.
@@ -331,7 +341,8 @@ mod tests {
     /// FLOP count is that of the transitions computed (2 × 16 windows × 9 steps).
     #[test]
     fn batch_times_are_consistent() {
-        let (elbo, params) = paper_objective(32, 10, 1).unwrap();
+        let spec = FitSpec::preset(Preset::Paper, 7, 5);
+        let (elbo, params) = synthetic_objective(&spec, 32, 10, 1).unwrap();
         let t = time_batches(&elbo, &params, 2, 1).unwrap();
         assert!(t.fastest_s > 0.0 && 2.0 * t.fastest_s <= t.total_s, "{t:?}");
         let per_step = train_step_flops(elbo.config(), elbo.options().particles);

@@ -1,0 +1,138 @@
+//! `flapssm bench`: the engine's speed in the paper's configuration (512 sequences × 470 steps,
+//! D_x 12, M 100, 30 particles, batch 16) on synthetic data of its shapes, beside the authors'
+//! code (prssm-notes §3) and this machine's own f64 GEMM rate.
+
+use flapssm_prssm::train::bench::{
+    REFERENCE_SOLVE_S, gemm_rate_gflops, initial_model, predict_step_flops,
+    reference_solve_seconds, synthetic_objective, time_batches, time_prediction, time_stream_step,
+};
+use flapssm_prssm::train::fit::{FitSpec, Preset};
+
+use crate::error::{JobError, Result};
+use crate::threads::current_threads;
+
+/// The authors' code: one training epoch (s), prssm-notes §3.
+pub const AUTHORS_EPOCH_S: f64 = 81.8;
+/// The authors' code: prediction of one 470-step trajectory with 30 particles (s).
+pub const AUTHORS_PREDICT_S: f64 = 0.152;
+/// Steps of the timed prediction (one paper trajectory).
+pub const PREDICT_STEPS: usize = 470;
+/// Sequences of the timed training set (the paper's training set).
+pub const TRAIN_SEQUENCES: usize = 512;
+/// Minibatches per epoch of the paper's configuration (512 / 16).
+pub const BATCHES_PER_EPOCH: usize = 32;
+
+/// Settings of [`bench`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BenchSettings {
+    /// Minibatches timed (1..=32); the epoch is extrapolated from them.
+    pub batches: usize,
+    /// Repetitions of the prediction timing (the median is reported).
+    pub reps: usize,
+    /// Seed of the synthetic data and parameters.
+    pub seed: u64,
+}
+
+impl Default for BenchSettings {
+    fn default() -> Self {
+        Self {
+            batches: BATCHES_PER_EPOCH,
+            reps: 9,
+            seed: 0,
+        }
+    }
+}
+
+/// What [`bench`] measured.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BenchReport {
+    /// Threads of the pool the training ran on.
+    pub threads: usize,
+    /// f64 GEMM rate (512³, faer, one thread), GFLOP/s.
+    pub gemm_gflops: f64,
+    /// prssm-notes §4's triangular solve (100 × 100, 480 right-hand sides, one thread), s.
+    pub reference_solve_s: f64,
+    /// Minibatches timed.
+    pub batches: usize,
+    /// One epoch (32 × the mean timed minibatch), s.
+    pub epoch_s: f64,
+    /// 32 × the fastest timed minibatch, s.
+    pub fastest_epoch_s: f64,
+    /// Training FLOP rate, GFLOP/s.
+    pub train_gflops: f64,
+    /// Median prediction of one 470-step trajectory with 30 particles (one thread), s.
+    pub predict_s: f64,
+    /// Prediction FLOP rate, GFLOP/s.
+    pub predict_gflops: f64,
+    /// Mean streaming step with 30 particles, s.
+    pub stream_step_s: f64,
+    /// Streaming FLOP rate, GFLOP/s.
+    pub stream_gflops: f64,
+}
+
+impl BenchReport {
+    /// Epoch time if every FLOP ran at `threads` × the GEMM rate (the f64 FLOP limit), s.
+    pub fn flop_limit_epoch_s(&self) -> f64 {
+        self.epoch_s * self.train_gflops / (self.threads as f64 * self.gemm_gflops)
+    }
+}
+
+/// Times training minibatches, one prediction and streaming steps of the paper's
+/// configuration, on the current thread pool.
+///
+/// # Errors
+/// [`JobError::Setting`] for `batches` outside 1..=32 or no repetition; engine errors.
+pub fn bench(settings: &BenchSettings) -> Result<BenchReport> {
+    if !(1..=BATCHES_PER_EPOCH).contains(&settings.batches) {
+        return Err(JobError::Setting {
+            name: "batches".into(),
+            value: settings.batches.to_string(),
+            expected: format!("must be in 1..={BATCHES_PER_EPOCH}"),
+        });
+    }
+    if settings.reps == 0 {
+        return Err(JobError::Setting {
+            name: "reps".into(),
+            value: "0".into(),
+            expected: "must be at least 1".into(),
+        });
+    }
+    let engine = |what: &str, e: &dyn std::fmt::Display| JobError::Mismatch {
+        what: format!("bench: {what}"),
+        expected: "a run of the engine".into(),
+        found: e.to_string(),
+    };
+    let spec = FitSpec::preset(Preset::Paper, 7, 5);
+    let gemm_gflops = gemm_rate_gflops(512, 0.3);
+    let reference_solve_s = reference_solve_seconds(0.2);
+    let (elbo, params) = synthetic_objective(&spec, TRAIN_SEQUENCES, PREDICT_STEPS, settings.seed)
+        .map_err(|e| engine("building the paper objective", &e))?;
+    let times = time_batches(&elbo, &params, settings.batches, settings.seed)
+        .map_err(|e| engine("timing training batches", &e))?;
+    let per_epoch = BATCHES_PER_EPOCH as f64 / settings.batches as f64;
+    let model = initial_model(&spec, settings.seed);
+    let predict_s = time_prediction(&model, PREDICT_STEPS, spec.particles, settings.reps)
+        .map_err(|e| engine("timing prediction", &e))?;
+    let step_flops = predict_step_flops(&model.config, spec.particles);
+    let stream_step_s = time_stream_step(&model, spec.particles, 2000)
+        .map_err(|e| engine("timing streaming", &e))?;
+    Ok(BenchReport {
+        threads: current_threads(),
+        gemm_gflops,
+        reference_solve_s,
+        batches: settings.batches,
+        epoch_s: times.total_s * per_epoch,
+        fastest_epoch_s: times.fastest_s * BATCHES_PER_EPOCH as f64,
+        train_gflops: times.flop / times.total_s / 1e9,
+        predict_s,
+        predict_gflops: (PREDICT_STEPS - 1) as f64 * step_flops / predict_s / 1e9,
+        stream_step_s,
+        stream_gflops: step_flops / stream_step_s / 1e9,
+    })
+}
+
+/// The machine of the authors' timings solved [`REFERENCE_SOLVE_S`]; this one's speed
+/// relative to it.
+pub fn speed_against_reference_machine(report: &BenchReport) -> f64 {
+    REFERENCE_SOLVE_S / report.reference_solve_s
+}
