@@ -112,8 +112,7 @@ fn tiny_demo_evaluate_and_sweep() {
         "5",
     ]);
     let m2 = json(&ev.join("metrics.json"));
-    assert_eq!(m2["prssm"], m["prssm"]);
-    assert_eq!(m2["lrqsm"], m["lrqsm"]);
+    assert_eq!(m2["models"], m["models"]);
 
     // `predict` with the same seed draws what `evaluate` and the demo drew (one seed rule).
     let pred = tmp.path().join("pred.npz");

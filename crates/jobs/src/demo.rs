@@ -31,9 +31,13 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{JobError, Result};
 use crate::evaluate::{
-    AuthorityFinding, EvalOptions, EvaluationReport, ReportContext, evaluate, versions,
+    AuthorityFinding, EvalOptions, EvaluationReport, METRICS_VERSION, ReportContext, evaluate,
+    versions,
 };
 use crate::files::{load_json, save_json};
+use crate::models::LoadModel;
+use crate::models::lrqsm::LrqsmLoadModel;
+use crate::models::prssm::PrssmLoadModel;
 use crate::progress::Progress;
 use crate::train::{TrainingOptions, train_prssm};
 use flapssm_analysis::stats::{Interval, median};
@@ -170,6 +174,8 @@ pub struct DemoSummary {
     pub prssm_cycle_average_ci: Vec<Interval>,
     /// Same for the LRQSM.
     pub lrqsm_cycle_average_ci: Vec<Interval>,
+    /// Further baselines evaluated beside the PR-SSM and the LRQSM (the ARX model).
+    pub baselines: Vec<BaselineSummary>,
     /// AoA and a_x on the output states.
     pub authority: Vec<AuthorityFinding>,
     /// Median over the output states of AoA's median lag (cycles).
@@ -188,6 +194,17 @@ pub struct DemoSummary {
     pub versions: Vec<(String, String)>,
     /// The evaluation report, relative to the demo folder.
     pub report: String,
+}
+
+/// Test accuracy of a further baseline.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct BaselineSummary {
+    /// Display name.
+    pub model: String,
+    /// Test RMSE per output (σ units; training set without a test set).
+    pub test_rmse: Vec<f64>,
+    /// Overall test RMSE (σ units).
+    pub overall_test_rmse: f64,
 }
 
 #[derive(Debug, Clone, Default, Serialize, Deserialize)]
@@ -400,8 +417,10 @@ pub fn run_demo(
     let eval_dir = dir.join("eval");
     let metrics_path = eval_dir.join("metrics.json");
     let report_path = eval_dir.join("report.html");
-    let k_ev =
-        serde_json::json!({ "lrqsm": k_lq, "prssm": k_pm, "evaluation": json(&cfg.evaluation) });
+    let k_ev = serde_json::json!({
+        "lrqsm": k_lq, "prssm": k_pm,
+        "evaluation": json(&cfg.evaluation), "metrics_version": METRICS_VERSION,
+    });
     let timings_so_far: Vec<(String, String)> = run
         .timings
         .iter()
@@ -428,12 +447,15 @@ pub fn run_demo(
                 headline: timings_so_far,
                 config: json(cfg),
             };
+            let e = &cfg.evaluation;
+            let prssm = PrssmLoadModel::new(&prssm, &ds, e.particles, e.seed)?;
+            let lrqsm = LrqsmLoadModel::new(&lrqsm)?;
+            let models: [&dyn LoadModel; 2] = [&prssm, &lrqsm];
             evaluate(
                 &ds,
                 &ds_path.display().to_string(),
-                &prssm,
-                &lrqsm,
-                &cfg.evaluation,
+                &models,
+                e,
                 &ctx,
                 &eval_dir,
                 p,
@@ -466,10 +488,8 @@ fn summarize(
     timings: Vec<StageTiming>,
     total_wall_s: f64,
 ) -> DemoSummary {
-    let (p, l) = match (&r.prssm.test, &r.lrqsm.test) {
-        (Some(a), Some(b)) => (a, b),
-        _ => (&r.prssm.train, &r.lrqsm.train),
-    };
+    let (pm, lm) = (&r.models[0], &r.models[1]);
+    let (p, l) = (pm.test_or_train(), lm.test_or_train());
     let lag_of = |input: &str, f: fn(&AuthorityFinding) -> f64| {
         let v: Vec<f64> = r
             .authority_findings
@@ -491,8 +511,16 @@ fn summarize(
         ratio_target: RATIO_TARGET,
         ratio_target_met: r.rmse_ratio.iter().all(|v| *v <= RATIO_TARGET),
         overall_test_rmse: [p.overall_rmse_standardized, l.overall_rmse_standardized],
-        prssm_cycle_average_ci: r.prssm.cycle_average_error_interval_all.clone(),
-        lrqsm_cycle_average_ci: r.lrqsm.cycle_average_error_interval_all.clone(),
+        prssm_cycle_average_ci: pm.cycle_average_error_interval_all.clone(),
+        lrqsm_cycle_average_ci: lm.cycle_average_error_interval_all.clone(),
+        baselines: r.models[2..]
+            .iter()
+            .map(|m| BaselineSummary {
+                model: m.model.clone(),
+                test_rmse: m.test_or_train().rmse_standardized.clone(),
+                overall_test_rmse: m.test_or_train().overall_rmse_standardized,
+            })
+            .collect(),
         authority: r.authority_findings.clone(),
         aoa_median_lag_cycles: lag_of("AoA", |a| a.median_lag_cycles),
         a_x_median_lag_cycles: lag_of("a_x", |a| a.median_lag_cycles),

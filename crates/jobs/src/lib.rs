@@ -7,6 +7,7 @@
 //! |---|---|
 //! | [`train`] | PR-SSM training on a dataset's training trajectories (settings, checkpoints, resume) |
 //! | [`predict`] | open-loop predictions of every trajectory of a dataset (PR-SSM, LRQSM) |
+//! | [`models`] | the load models behind one trait (PR-SSM, LRQSM, ARX) |
 //! | [`evaluate`] | both models on a dataset: metrics, authority, figures, report |
 //! | [`sweep`] | one-configuration PR-SSM sweep runs (D_x, training-set size) and their merge |
 //! | [`demo`] | the one-command demo: simulate, fit, train, evaluate (resumable) |
@@ -25,6 +26,7 @@ pub mod demo;
 pub mod error;
 pub mod evaluate;
 pub mod files;
+pub mod models;
 pub mod predict;
 pub mod progress;
 pub mod seed;

@@ -10,12 +10,12 @@ use flapssm_data::npz::{NpyData, NpzWriter};
 use flapssm_data::{Dataset, Trajectory};
 use flapssm_prssm::predict::Prediction;
 use flapssm_prssm::train::InitialStateSpec;
-use flapssm_prssm::train::fit::predict_raw;
 use flapssm_prssm::train::fit::training_record;
 use flapssm_prssm::{PrssmModel, Sequence};
 use flapssm_qs::{InterceptMode, LrqsmModel};
 
 use crate::error::{JobError, Result};
+use crate::models::prssm::PrssmLoadModel;
 use crate::progress::Progress;
 use crate::seed::prediction_seed;
 
@@ -35,18 +35,6 @@ pub fn trajectory_sequence(t: &Trajectory) -> Sequence {
             .map(|y| y.as_flattened().to_vec())
             .unwrap_or_default(),
     }
-}
-
-fn check_model_shape(model: &PrssmModel) -> Result<()> {
-    let c = &model.config;
-    if c.n_input != 7 || c.n_output != 5 {
-        return Err(JobError::Mismatch {
-            what: "PR-SSM model inputs/outputs".into(),
-            expected: "7 inputs and 5 outputs (the dataset's)".into(),
-            found: format!("{} inputs, {} outputs", c.n_input, c.n_output),
-        });
-    }
-    Ok(())
 }
 
 /// The model as it applies to `ds`'s physical units: unchanged when it carries normalization
@@ -87,19 +75,9 @@ pub fn predict_prssm(
     seed: u64,
     progress: &dyn Progress,
 ) -> Result<Vec<PrssmPrediction>> {
-    check_model_shape(model)?;
-    let model = &*in_dataset_units(model, ds)?;
+    let model = PrssmLoadModel::new(model, ds, particles, seed)?;
     let one = |(i, t): (usize, &Trajectory)| -> Result<PrssmPrediction> {
-        let p = predict_raw(
-            model,
-            &trajectory_sequence(t),
-            particles,
-            prediction_seed(seed, i),
-        )
-        .map_err(|source| JobError::Prssm {
-            what: format!("prediction of trajectory {i}"),
-            source,
-        })?;
+        let p = model.predict(i, t)?;
         progress.advance(1);
         Ok(p)
     };
@@ -153,7 +131,6 @@ pub fn predict_dataset_file(
     out: &Path,
     progress: &dyn Progress,
 ) -> Result<DatasetPredictionSummary> {
-    check_model_shape(model)?;
     let mut notes = Vec::new();
     if model.normalization.is_none() {
         if !ds.has_outputs() {

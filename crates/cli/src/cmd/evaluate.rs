@@ -6,23 +6,28 @@ use anyhow::Context;
 use clap::Args;
 use flapssm_data::Dataset;
 use flapssm_jobs::evaluate::{EvalOptions, ReportContext, evaluate};
+use flapssm_jobs::models::LoadModel;
+use flapssm_jobs::models::lrqsm::LrqsmLoadModel;
+use flapssm_jobs::models::prssm::PrssmLoadModel;
 use flapssm_prssm::PrssmModel;
 use flapssm_qs::LrqsmModel;
 
 use crate::progress::Bars;
 
-/// Evaluate a PR-SSM and an LRQSM on a dataset's training and test trajectories.
+/// Evaluate load models (a PR-SSM, an LRQSM) on a dataset's training and
+/// test trajectories.
 #[derive(Args)]
+#[command(group(clap::ArgGroup::new("models").required(true).multiple(true).args(["prssm", "lrqsm"])))]
 pub struct EvaluateArgs {
     /// Dataset file (flapssm .npz) with outputs.
     #[arg(long)]
     dataset: PathBuf,
     /// PR-SSM model file (.json, from `flapssm train`).
     #[arg(long)]
-    prssm: PathBuf,
+    prssm: Option<PathBuf>,
     /// LRQSM model file (.json, from `flapssm qs fit`).
     #[arg(long)]
-    lrqsm: PathBuf,
+    lrqsm: Option<PathBuf>,
     /// Output folder.
     #[arg(long)]
     out: PathBuf,
@@ -39,37 +44,69 @@ pub struct EvaluateArgs {
 
 /// Runs `flapssm evaluate`.
 pub fn run(a: EvaluateArgs) -> anyhow::Result<()> {
-    let ds = Dataset::load(&a.dataset)
-        .with_context(|| format!("loading dataset {}", a.dataset.display()))?;
-    let prssm = PrssmModel::load(&a.prssm)
-        .with_context(|| format!("loading PR-SSM model {}", a.prssm.display()))?;
-    let lrqsm = LrqsmModel::load(&a.lrqsm)
-        .with_context(|| format!("loading LRQSM model {}", a.lrqsm.display()))?;
     let opts = EvalOptions {
         particles: a.particles,
         seed: a.seed,
         start_sample: a.start_sample,
         ..EvalOptions::default()
     };
+    let ds = Dataset::load(&a.dataset)
+        .with_context(|| format!("loading dataset {}", a.dataset.display()))?;
+    let prssm = a
+        .prssm
+        .as_ref()
+        .map(|p| {
+            PrssmModel::load(p).with_context(|| format!("loading PR-SSM model {}", p.display()))
+        })
+        .transpose()?;
+    let lrqsm = a
+        .lrqsm
+        .as_ref()
+        .map(|p| {
+            LrqsmModel::load(p).with_context(|| format!("loading LRQSM model {}", p.display()))
+        })
+        .transpose()?;
+    let prssm = prssm
+        .as_ref()
+        .map(|m| PrssmLoadModel::new(m, &ds, opts.particles, opts.seed))
+        .transpose()
+        .with_context(|| format!("PR-SSM on {}", a.dataset.display()))?;
+    let lrqsm = lrqsm
+        .as_ref()
+        .map(LrqsmLoadModel::new)
+        .transpose()
+        .with_context(|| format!("LRQSM on {}", a.dataset.display()))?;
+    let bars = Bars::new();
+    let mut models: Vec<&dyn LoadModel> = Vec::new();
+    if let Some(m) = &prssm {
+        models.push(m);
+    }
+    if let Some(m) = &lrqsm {
+        models.push(m);
+    }
     let ctx = ReportContext {
         intro: format!(
-            "PR-SSM {} and LRQSM {} evaluated on {}.",
-            a.prssm.display(),
-            a.lrqsm.display(),
+            "{} evaluated on {}.",
+            models
+                .iter()
+                .map(|m| m.name())
+                .collect::<Vec<_>>()
+                .join(", "),
             a.dataset.display()
         ),
-        config: serde_json::json!({ "dataset": a.dataset, "prssm": a.prssm, "lrqsm": a.lrqsm }),
+        config: serde_json::json!({
+            "dataset": a.dataset, "prssm": a.prssm, "lrqsm": a.lrqsm,
+        }),
         ..ReportContext::default()
     };
     let r = evaluate(
         &ds,
         &a.dataset.display().to_string(),
-        &prssm,
-        &lrqsm,
+        &models,
         &opts,
         &ctx,
         &a.out,
-        &Bars::new(),
+        &bars,
     )
     .with_context(|| format!("evaluating on {}", a.dataset.display()))?;
     let f = |v: &[f64]| {
@@ -78,7 +115,7 @@ pub fn run(a: EvaluateArgs) -> anyhow::Result<()> {
             .collect::<Vec<_>>()
             .join(" ")
     };
-    for m in [&r.prssm, &r.lrqsm] {
+    for m in &r.models {
         println!(
             "{:<7} train RMSE (σ) {}",
             m.model,
@@ -88,7 +125,14 @@ pub fn run(a: EvaluateArgs) -> anyhow::Result<()> {
             println!("{:<7} test  RMSE (σ) {}", m.model, f(&t.rmse_standardized));
         }
     }
-    println!("ratio PR-SSM/LRQSM    {}", f(&r.rmse_ratio));
+    if let [first, second, ..] = &r.models[..] {
+        println!(
+            "ratio {}/{}    {}",
+            first.model,
+            second.model,
+            f(&r.rmse_ratio)
+        );
+    }
     println!(
         "wrote {} (report.html, metrics.json, figures)",
         a.out.display()

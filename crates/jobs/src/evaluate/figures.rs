@@ -3,14 +3,14 @@
 use std::path::Path;
 
 use flapssm_data::Dataset;
-use flapssm_prssm::PrssmModel;
-use flapssm_prssm::train::fit::training_record;
+use flapssm_prssm::train::EpochRecord;
 
 use flapssm_analysis::plots::{timeseries as pt, training};
 
 use super::TrajectoryMetrics;
 use super::prepared::Prepared;
 use crate::error::{Result, analysis};
+use crate::models::LoadModel;
 
 /// Up to `k` test trajectories (training ones when there is no test set), distinct families
 /// first, in dataset order.
@@ -50,18 +50,24 @@ pub(super) fn example_title(ds: &Dataset, i: usize, m: &TrajectoryMetrics) -> St
     format!("{name} ({})", m.family)
 }
 
+/// Fig. 3: for each example trajectory, the wing's last cycle and measured against each
+/// model's C_Fx and C_Fy (with ±2σ bands for models with variances).
 pub(super) fn draw_fig3(
     path: &Path,
     ds: &Dataset,
+    models: &[&dyn LoadModel],
     prep: &[Prepared],
     examples: &[usize],
     labels: &[String],
 ) -> Result<()> {
     let n = ds.n_samples();
+    /// A pair of [C_Fx, C_Fy] columns over the window.
+    type Pair = [Vec<f64>; 2];
     struct Data {
         t: Vec<f64>,
         euler: Vec<[f64; 3]>,
-        cols: [[Vec<f64>; 2]; 4],
+        measured: Pair,
+        models: Vec<(Pair, Option<Pair>)>,
         title: String,
     }
     let data: Vec<Data> = examples
@@ -79,6 +85,11 @@ pub(super) fn draw_fig3(
                     .collect();
                 flapssm_analysis::metrics::rms(&e)
             };
+            let rmse: Vec<String> = p
+                .models
+                .iter()
+                .map(|m| format!("{:.2}", rm(&m.c, 0)))
+                .collect();
             Ok(Data {
                 t: (0..=p.window.duration)
                     .map(|k| k as f64 / p.window.duration as f64)
@@ -87,52 +98,51 @@ pub(super) fn draw_fig3(
                     .clone()
                     .map(|k| ds.trajectories[i].euler_rad[k])
                     .collect(),
-                cols: [
-                    pair(&p.measured_c),
-                    pair(&p.prssm_c),
-                    pair(&p.prssm_std_c),
-                    pair(&p.lrqsm_c),
-                ],
-                title: format!(
-                    "{label}: RMSE C_Fx {:.2}/{:.2}",
-                    rm(&p.prssm_c, 0),
-                    rm(&p.lrqsm_c, 0)
-                ),
+                measured: pair(&p.measured_c),
+                models: p
+                    .models
+                    .iter()
+                    .map(|m| (pair(&m.c), m.std_c.as_deref().map(pair)))
+                    .collect(),
+                title: format!("{label}: RMSE C_Fx {}", rmse.join("/")),
             })
         })
         .collect::<Result<_>>()?;
-    let models: Vec<[pt::CoefficientCurves<'_>; 2]> = data
+    let names: Vec<String> = models
+        .iter()
+        .zip(&data.first().map_or(&Vec::new(), |d| &d.models).to_vec())
+        .map(|(m, (_, std))| match std {
+            Some(_) => format!("{} ±2σ", m.name()),
+            None => m.name().to_string(),
+        })
+        .collect();
+    let curves: Vec<Vec<pt::CoefficientCurves<'_>>> = data
         .iter()
         .map(|d| {
-            [
-                pt::CoefficientCurves {
-                    label: "PR-SSM ±2σ",
-                    cfx: &d.cols[1][0],
-                    cfy: &d.cols[1][1],
-                    cfx_std: Some(&d.cols[2][0]),
-                    cfy_std: Some(&d.cols[2][1]),
-                },
-                pt::CoefficientCurves {
-                    label: "LRQSM",
-                    cfx: &d.cols[3][0],
-                    cfy: &d.cols[3][1],
-                    cfx_std: None,
-                    cfy_std: None,
-                },
-            ]
+            d.models
+                .iter()
+                .zip(&names)
+                .map(|((c, std), label)| pt::CoefficientCurves {
+                    label,
+                    cfx: &c[0],
+                    cfy: &c[1],
+                    cfx_std: std.as_ref().map(|s| &s[0][..]),
+                    cfy_std: std.as_ref().map(|s| &s[1][..]),
+                })
+                .collect()
         })
         .collect();
     let panels: Vec<pt::TrajectoryPanel<'_>> = data
         .iter()
-        .zip(&models)
+        .zip(&curves)
         .map(|(d, m)| pt::TrajectoryPanel {
             title: &d.title,
             t: &d.t,
             euler_rad: &d.euler,
             measured: pt::CoefficientCurves {
                 label: "measured",
-                cfx: &d.cols[0][0],
-                cfy: &d.cols[0][1],
+                cfx: &d.measured[0],
+                cfy: &d.measured[1],
                 cfx_std: None,
                 cfy_std: None,
             },
@@ -147,20 +157,22 @@ pub(super) fn draw_fig3(
     pt::time_histories(path, "t̂ (cycles)", &panels, &sketch).map_err(analysis("Fig. 3"))
 }
 
-/// Draws the training curves of a model fitted by the trainer; `false` when it has no history.
-pub(super) fn draw_training(f_loss: &Path, f_rmse: &Path, model: &PrssmModel) -> Result<bool> {
-    let Ok(rec) = training_record(model) else {
-        return Ok(false);
-    };
-    if rec.history.is_empty() {
+/// Draws the training curves of `name`'s per-epoch `history`; `false` when it is empty.
+pub(super) fn draw_training(
+    f_loss: &Path,
+    f_rmse: &Path,
+    name: &str,
+    history: &[EpochRecord],
+) -> Result<bool> {
+    if history.is_empty() {
         return Ok(false);
     }
-    let ep: Vec<f64> = rec.history.iter().map(|r| r.epoch as f64 + 1.0).collect();
-    let loss: Vec<f64> = rec.history.iter().map(|r| r.mean_loss).collect();
+    let ep: Vec<f64> = history.iter().map(|r| r.epoch as f64 + 1.0).collect();
+    let loss: Vec<f64> = history.iter().map(|r| r.mean_loss).collect();
     let log = loss.iter().all(|v| *v > 0.0);
     training::training_curves(
         f_loss,
-        "PR-SSM training objective",
+        &format!("{name} training objective"),
         "mean minibatch −ELBO",
         &[training::TrainingCurve {
             label: "−ELBO",
@@ -170,9 +182,8 @@ pub(super) fn draw_training(f_loss: &Path, f_rmse: &Path, model: &PrssmModel) ->
         log,
     )
     .map_err(analysis("training loss figure"))?;
-    let series = |f: &dyn Fn(&flapssm_prssm::train::EpochRecord) -> Option<f64>| {
-        let (e, v): (Vec<f64>, Vec<f64>) = rec
-            .history
+    let series = |f: &dyn Fn(&EpochRecord) -> Option<f64>| {
+        let (e, v): (Vec<f64>, Vec<f64>) = history
             .iter()
             .filter_map(|r| f(r).map(|v| (r.epoch as f64 + 1.0, v)))
             .unzip();
@@ -200,7 +211,7 @@ pub(super) fn draw_training(f_loss: &Path, f_rmse: &Path, model: &PrssmModel) ->
     }
     training::training_curves(
         f_rmse,
-        "PR-SSM open-loop RMSE during training",
+        &format!("{name} open-loop RMSE during training"),
         "RMSE (standardized, after burn-in)",
         &curves,
         false,

@@ -3,25 +3,31 @@
 use std::path::PathBuf;
 
 use flapssm_data::OUTPUT_NAMES;
-use flapssm_prssm::PrssmModel;
-use flapssm_prssm::train::fit::training_record;
-use flapssm_qs::LrqsmModel;
 
 use flapssm_analysis::report::{Figure, Report, Section, Table};
 use flapssm_analysis::stats::Interval;
 
-use super::{COEFFICIENT_LABELS, EvaluationReport, ModelMetrics, ReportContext};
+use super::{COEFFICIENT_LABELS, EvaluationReport, ReportContext};
+use crate::models::LoadModel;
 
 pub(super) struct ReportFigures {
     pub(super) f_2c: PathBuf,
     pub(super) f_3: PathBuf,
-    pub(super) f_4a_train: PathBuf,
+    pub(super) f_4a_train: Option<PathBuf>,
     pub(super) f_4a_test: Option<PathBuf>,
     pub(super) f_4b: PathBuf,
-    pub(super) f_5a: PathBuf,
-    pub(super) f_5s: PathBuf,
-    pub(super) f_5b: PathBuf,
+    /// Fig. 5Ai, 5Aii, 5B, with a latent-state model.
+    pub(super) fig5: Option<(PathBuf, PathBuf, PathBuf)>,
+    /// Training loss and RMSE, with a training history.
     pub(super) training: Option<(PathBuf, PathBuf)>,
+}
+
+impl ReportFigures {
+    /// Whether the file named `name` was written (the training curves are named before it is
+    /// known whether the history has any).
+    pub(super) fn written(&self, name: &str) -> bool {
+        !name.starts_with("training_") || self.training.is_some()
+    }
 }
 
 fn f3(v: f64) -> String {
@@ -34,12 +40,20 @@ fn interval_cells(v: &[Interval]) -> Vec<String> {
         .collect()
 }
 
+/// "A / B / C" of the models' names.
+fn names(models: &[&dyn LoadModel]) -> String {
+    models
+        .iter()
+        .map(|m| m.name())
+        .collect::<Vec<_>>()
+        .join(" / ")
+}
+
 pub(super) fn html_report(
     r: &EvaluationReport,
     ctx: &ReportContext,
     f: ReportFigures,
-    prssm: &PrssmModel,
-    lrqsm: &LrqsmModel,
+    models: &[&dyn LoadModel],
 ) -> Report {
     let row = |label: String, cells: Vec<String>| std::iter::once(label).chain(cells).collect();
     let header = |first: &str, names: &[&str]| -> Vec<String> {
@@ -47,10 +61,14 @@ pub(super) fn html_report(
             .chain(names.iter().map(|s| s.to_string()))
             .collect()
     };
+    let ratio_label = match &r.models[..] {
+        [a, b, ..] => Some(format!("{} / {}", a.model, b.model)),
+        _ => None,
+    };
     let mut rmse_rows = Vec::new();
     let mut ci_rows = Vec::new();
     let mut cyc_rows = Vec::new();
-    for m in [&r.prssm, &r.lrqsm] {
+    for m in &r.models {
         for (split, s) in [("train", Some(&m.train)), ("test", m.test.as_ref())] {
             let Some(s) = s else { continue };
             let mut cells: Vec<String> = s.rmse_standardized.iter().map(|v| f3(*v)).collect();
@@ -74,10 +92,12 @@ pub(super) fn html_report(
             interval_cells(&m.cycle_average_error_interval_all),
         ));
     }
-    rmse_rows.push(row(
-        "ratio PR-SSM / LRQSM (test)".into(),
-        r.rmse_ratio.iter().map(|v| f3(*v)).collect(),
-    ));
+    if let Some(label) = &ratio_label {
+        rmse_rows.push(row(
+            format!("ratio {label} (test)"),
+            r.rmse_ratio.iter().map(|v| f3(*v)).collect(),
+        ));
+    }
     let mut rmse_header = header("model, set", &OUTPUT_NAMES);
     rmse_header.push("overall".into());
     rmse_header.push("median last-cycle RMSE C_Fx / C_Fy".into());
@@ -101,43 +121,51 @@ pub(super) fn html_report(
         .iter()
         .filter(|t| t.split == "test")
         .map(|t| {
-            vec![
+            let mut cells = vec![
                 format!("{}", t.index - r.n_train + 1),
                 t.family.clone(),
                 format!("{:.3}", t.u_ref_m_s),
                 t.period_samples.to_string(),
-                f3(t.prssm_cycle_rmse_cf[0]),
-                f3(t.lrqsm_cycle_rmse_cf[0]),
-                f3(t.prssm_cycle_rmse_cf[1]),
-                f3(t.lrqsm_cycle_rmse_cf[1]),
-            ]
+            ];
+            for c in 0..2 {
+                cells.extend(t.models.iter().map(|m| f3(m.cycle_rmse_cf[c])));
+            }
+            cells
         })
         .collect();
-    let overall = |m: &ModelMetrics| {
-        m.test
-            .as_ref()
-            .unwrap_or(&m.train)
-            .overall_rmse_standardized
-    };
+    let mut test_header: Vec<String> = ["test #", "family", "U_ref (m/s)", "period (samples)"]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+    for c in ["C_Fx", "C_Fy"] {
+        test_header.extend(r.models.iter().map(|m| format!("{c} {}", m.model)));
+    }
+    let overall: Vec<String> = r
+        .models
+        .iter()
+        .map(|m| format!("{:.3}", m.test_or_train().overall_rmse_standardized))
+        .collect();
     let mut headline = vec![
         (
             "dataset".to_string(),
             format!("{} ({} train / {} test)", r.dataset, r.n_train, r.n_test),
         ),
         (
-            "overall test RMSE PR-SSM / LRQSM (σ units)".into(),
-            format!("{:.3} / {:.3}", overall(&r.prssm), overall(&r.lrqsm)),
+            format!("overall test RMSE {} (σ units)", names(models)),
+            overall.join(" / "),
         ),
-        (
-            "test RMSE ratio PR-SSM / LRQSM per output".into(),
+    ];
+    if let Some(label) = &ratio_label {
+        headline.push((
+            format!("test RMSE ratio {label} per output"),
             r.rmse_ratio
                 .iter()
                 .zip(OUTPUT_NAMES)
                 .map(|(v, n)| format!("{n} {v:.2}"))
                 .collect::<Vec<_>>()
                 .join(", "),
-        ),
-    ];
+        ));
+    }
     for input in ["AoA", "a_x"] {
         let lags: Vec<String> = r
             .authority_findings
@@ -145,72 +173,73 @@ pub(super) fn html_report(
             .filter(|a| a.input == input)
             .map(|a| format!("{} {:.2}", a.state, a.median_lag_cycles))
             .collect();
-        headline.push((
-            format!("median lag of {input} → output states (cycles)"),
-            lags.join(", "),
-        ));
+        if !lags.is_empty() {
+            headline.push((
+                format!("median lag of {input} → output states (cycles)"),
+                lags.join(", "),
+            ));
+        }
     }
     headline.extend(ctx.headline.iter().cloned());
-    let mut accuracy_figs = vec![
-        Figure {
-            caption: "Fig. 3 — last full cycle of test trajectories: chord sketch, Euler angles, measured and predicted C_Fx, C_Fy (title: last-cycle C_Fx RMSE PR-SSM/LRQSM)".into(),
-            path: f.f_3,
-        },
-        Figure {
-            caption: "Fig. 4A — standardized-error histograms, training set, with 95 % intervals".into(),
-            path: f.f_4a_train,
-        },
-    ];
-    if let Some(p) = f.f_4a_test {
-        accuracy_figs.push(Figure {
-            caption: "Fig. 4A — standardized-error histograms, test set, with 95 % intervals"
-                .into(),
-            path: p,
-        });
+    let mut accuracy_figs = vec![Figure {
+        caption: format!(
+            "Fig. 3 — last full cycle of test trajectories: chord sketch, Euler angles, measured and predicted C_Fx, C_Fy (title: last-cycle C_Fx RMSE {})",
+            names(models).replace(" / ", "/")
+        ),
+        path: f.f_3,
+    }];
+    for (path, set) in [(f.f_4a_train, "training"), (f.f_4a_test, "test")] {
+        if let Some(path) = path {
+            accuracy_figs.push(Figure {
+                caption: format!(
+                    "Fig. 4A — standardized-error histograms, {set} set, with 95 % intervals"
+                ),
+                path,
+            });
+        }
     }
     accuracy_figs.push(Figure {
         caption: "Fig. 4B — half-stroke averages: error vs measured value, training and test, with 95 % intervals".into(),
         path: f.f_4b,
     });
-    let mut sections = vec![
-        Section {
-            heading: "Accuracy".into(),
-            paragraphs: vec![format!(
-                "Errors are measured − predicted. Standardized errors use the training mean and standard deviation of each output and samples from {} on (0-based; the first {} samples are dropped). Intervals are the {}-% central percentile intervals (MATLAB prctile). Cycle averages are half-stroke means of the load coefficients over the last full stroke cycle.",
-                r.options.start_sample, r.options.start_sample, r.options.level
-            )],
-            tables: vec![
-                Table {
-                    caption: "RMSE per output (σ units) and median last-cycle coefficient RMSE".into(),
-                    header: rmse_header,
-                    rows: rmse_rows,
-                },
-                Table {
-                    caption: "95 % intervals of the standardized errors".into(),
-                    header: header("model, set", &OUTPUT_NAMES),
-                    rows: ci_rows,
-                },
-                Table {
-                    caption: "95 % intervals of the half-stroke-average errors (coefficients)".into(),
-                    header: header("model, set", &COEFFICIENT_LABELS),
-                    rows: cyc_rows,
-                },
-                Table {
-                    caption: "Test trajectories: last-cycle RMSE of the force coefficients".into(),
-                    header: [
-                        "test #", "family", "U_ref (m/s)", "period (samples)",
-                        "C_Fx PR-SSM", "C_Fx LRQSM", "C_Fy PR-SSM", "C_Fy LRQSM",
-                    ]
-                    .iter()
-                    .map(|s| s.to_string())
-                    .collect(),
-                    rows: test_traj,
-                },
-            ],
-            figures: accuracy_figs,
-        },
-        Section {
-            heading: "Control authority (cross-correlation of the PR-SSM latent means)".into(),
+    let mut sections = vec![Section {
+        heading: "Accuracy".into(),
+        paragraphs: vec![format!(
+            "Errors are measured − predicted. Standardized errors use the training mean and standard deviation of each output and samples from {} on (0-based; the first {} samples are dropped). Intervals are the {}-% central percentile intervals (MATLAB prctile). Cycle averages are half-stroke means of the load coefficients over the last full stroke cycle.",
+            r.options.start_sample, r.options.start_sample, r.options.level
+        )],
+        tables: vec![
+            Table {
+                caption: "RMSE per output (σ units) and median last-cycle coefficient RMSE".into(),
+                header: rmse_header,
+                rows: rmse_rows,
+            },
+            Table {
+                caption: "95 % intervals of the standardized errors".into(),
+                header: header("model, set", &OUTPUT_NAMES),
+                rows: ci_rows,
+            },
+            Table {
+                caption: "95 % intervals of the half-stroke-average errors (coefficients)".into(),
+                header: header("model, set", &COEFFICIENT_LABELS),
+                rows: cyc_rows,
+            },
+            Table {
+                caption: "Test trajectories: last-cycle RMSE of the force coefficients".into(),
+                header: test_header,
+                rows: test_traj,
+            },
+        ],
+        figures: accuracy_figs,
+    }];
+    if let (Some((f_5a, f_5s, f_5b)), Some(latent)) =
+        (f.fig5, models.iter().find(|m| m.n_latent() > 0))
+    {
+        sections.push(Section {
+            heading: format!(
+                "Control authority (cross-correlation of the {} latent means)",
+                latent.name()
+            ),
             paragraphs: vec![format!(
                 "Per trajectory, state and input: the largest |r| of the normalized cross-correlation (MATLAB crosscorr) over lags 0 < lag < {} cycle, state lagging input; pooled over all {} trajectories with a reflected 2-D Gaussian KDE (bandwidth {}).",
                 r.options.authority.max_lag_cycles,
@@ -231,30 +260,33 @@ pub(super) fn html_report(
             figures: vec![
                 Figure {
                     caption: "Fig. 5Ai — 70 % highest-density regions and modes (+)".into(),
-                    path: f.f_5a,
+                    path: f_5a,
                 },
                 Figure {
                     caption: "Fig. 5Aii — state x1: max |r| vs lag per trajectory".into(),
-                    path: f.f_5s,
+                    path: f_5s,
                 },
                 Figure {
                     caption: "Fig. 5B — summary: radius ∝ median max |r|, lightness ∝ lag IQR, median lag printed for strong pairs".into(),
-                    path: f.f_5b,
+                    path: f_5b,
                 },
             ],
-        },
-        Section {
-            heading: "Wing motions".into(),
-            figures: vec![Figure {
-                caption: "Fig. 2C — last full cycle of the example test trajectories (chord at the U_ref radius, LE dotted)".into(),
-                path: f.f_2c,
-            }],
-            ..Default::default()
-        },
-    ];
-    if let Some((loss, rmse)) = f.training {
+        });
+    }
+    sections.push(Section {
+        heading: "Wing motions".into(),
+        figures: vec![Figure {
+            caption: "Fig. 2C — last full cycle of the example test trajectories (chord at the U_ref radius, LE dotted)".into(),
+            path: f.f_2c,
+        }],
+        ..Default::default()
+    });
+    if let (Some((loss, rmse)), Some(trained)) = (
+        f.training,
+        models.iter().find(|m| m.training_history().is_some()),
+    ) {
         sections.push(Section {
-            heading: "PR-SSM training".into(),
+            heading: format!("{} training", trained.name()),
             figures: vec![
                 Figure {
                     caption: "Mean minibatch negative ELBO per epoch".into(),
@@ -271,14 +303,17 @@ pub(super) fn html_report(
     let config = serde_json::json!({
         "run": ctx.config,
         "evaluation": r.options,
-        "prssm_model": prssm.config,
-        "prssm_training": training_record(prssm).ok().map(|t| t.spec),
-        "lrqsm": { "feature_set": lrqsm.feature_set, "options": lrqsm.options,
-                   "lambda": lrqsm.chosen.iter().map(|c| c.lambda).collect::<Vec<_>>() },
+        "models": models
+            .iter()
+            .map(|m| serde_json::json!({ "model": m.name(), "parameters": m.parameters() }))
+            .collect::<Vec<_>>(),
     });
     Report {
         title: if ctx.title.is_empty() {
-            "flapssm evaluation: PR-SSM vs LRQSM".into()
+            format!(
+                "flapssm evaluation: {}",
+                names(models).replace(" / ", " vs ")
+            )
         } else {
             ctx.title.clone()
         },

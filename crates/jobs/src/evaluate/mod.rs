@@ -1,31 +1,31 @@
-//! The evaluation pipeline: both models on a dataset → accuracy metrics, cycle averages,
-//! control authority of the PR-SSM latent states, figures and the HTML report.
+//! The evaluation pipeline: any number of load models on a dataset → accuracy metrics, cycle
+//! averages, control authority of the latent states, figures and the HTML report.
 //!
-//! Per trajectory `i` (n samples):
-//! - PR-SSM: open-loop prediction from the model's initial-state rule
-//!   ([`flapssm_prssm::train::fit::predict_raw`], `particles` particles, seed
-//!   `derive_seed(seed, 7, i)`): output mean/variance in N and N·mm, latent means (standardized
-//!   latent units, `n × D_x`).
-//! - LRQSM: [`flapssm_qs::lrqsm::predict_dataset`] with the fitted intercept.
+//! Per trajectory `i` (n samples) and model ([`LoadModel::predict_into`]):
+//! - output means (N, N·mm), variances where the model has them, latent means where it has
+//!   latent states (the PR-SSM: standardized latent units, `n × D_x`, particle draws seeded by
+//!   [`crate::seed::prediction_seed`]`(seed, i)`).
 //! - Standardized errors `e = (y − ŷ)/σ_y` with the dataset's training statistics
 //!   ([`Dataset::standardization`]), pooled from `start_sample` on (published: the first 93
 //!   samples dropped): per-output RMSE, overall `√mean(e²)`, 2.5/97.5 % intervals.
 //! - Coefficients `C_F = F/(½ρSU_ref²)`, `C_M = M/(½ρc̄SU_ref²·1000)` per trajectory; the last
 //!   full cycle from [`flapssm_wing::cycles::published_window`]; per-trajectory C_Fx/C_Fy RMSE
 //!   over it; half-stroke averages and their errors (measured − predicted) with intervals.
-//! - Control authority: [`flapssm_analysis::authority`] on (inputs, PR-SSM latent means) from
-//!   `start_sample` on, every trajectory (training and test), period = the cycle duration.
+//! - Control authority: [`flapssm_analysis::authority`] on (inputs, latent means of the first
+//!   model with latent states) from `start_sample` on, every trajectory (training and test),
+//!   period = the cycle duration.
+//!
+//! The first model is the one studied and the second its baseline: `rmse_ratio` is first /
+//! second, as the paper's PR-SSM / LRQSM.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use flapssm_data::{Dataset, OUTPUT_NAMES};
-use flapssm_prssm::PrssmModel;
-use flapssm_qs::LrqsmModel;
 use flapssm_wing::cycles::published_window;
 use serde::{Deserialize, Serialize};
 
 use flapssm_analysis::authority::{
-    AuthorityConfig, AuthoritySummary, AuthorityTrajectory, peak_table,
+    AuthorityConfig, AuthoritySummary, AuthorityTrajectory, PeakTable, peak_table,
 };
 use flapssm_analysis::cycles_avg::CycleWindow;
 use flapssm_analysis::metrics::{
@@ -37,7 +37,7 @@ use flapssm_analysis::stats::Interval;
 
 use crate::error::{JobError, Result, analysis};
 use crate::files::{write_json, write_text};
-use crate::predict::{predict_lrqsm, predict_prssm};
+use crate::models::{LoadModel, ModelPrediction, predict_all};
 use crate::progress::Progress;
 
 mod figures;
@@ -48,13 +48,15 @@ mod tables;
 use figures::{draw_fig3, draw_training, example_title, example_trajectories};
 pub use html::versions;
 use html::{ReportFigures, html_report};
-use prepared::{Pick, Prepared, cycle_errors, pooled, rows, split_metrics};
+use prepared::{ModelTables, Prepared, cycle_errors, pooled, rows, split_metrics};
 use tables::{trajectories_csv, write_predictions};
 
 /// Display names of the 7 inputs (dataset order).
 pub const INPUT_LABELS: [&str; 7] = ["AoA", "|v|", "a_x", "a_y", "a_z", "dα/dt", "d²α/dt²"];
 /// Display names of the 5 outputs as coefficients.
 pub const COEFFICIENT_LABELS: [&str; 5] = ["C_Fx", "C_Fy", "C_Mx", "C_My", "C_Mz"];
+/// Version of `metrics.json` ([`EvaluationReport`]): 2 holds any number of models.
+pub const METRICS_VERSION: u32 = 2;
 
 /// Settings of [`evaluate`].
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -108,14 +110,34 @@ pub struct SplitMetrics {
 /// Accuracy of one model.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ModelMetrics {
-    /// "PR-SSM" or "LRQSM".
+    /// Display name ("PR-SSM", "LRQSM", "ARX", …).
     pub model: String,
+    /// File-safe identifier ("prssm", …).
+    pub key: String,
     /// Training trajectories.
     pub train: SplitMetrics,
     /// Test trajectories (none when the dataset has no test part).
     pub test: Option<SplitMetrics>,
     /// Half-stroke-average error intervals over training and test together (as the paper).
     pub cycle_average_error_interval_all: Vec<Interval>,
+}
+
+impl ModelMetrics {
+    /// The test metrics, or the training metrics when there is no test set.
+    pub fn test_or_train(&self) -> &SplitMetrics {
+        self.test.as_ref().unwrap_or(&self.train)
+    }
+}
+
+/// One model's results on one trajectory.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct TrajectoryModelMetrics {
+    /// The model's key.
+    pub model: String,
+    /// Last-cycle RMSE of [C_Fx, C_Fy].
+    pub cycle_rmse_cf: [f64; 2],
+    /// Overall standardized RMSE from `start_sample` on.
+    pub overall_rmse: f64,
 }
 
 /// Per-trajectory results.
@@ -133,14 +155,8 @@ pub struct TrajectoryMetrics {
     pub period_samples: usize,
     /// First sample of the last-cycle window (0-based).
     pub window_start: usize,
-    /// PR-SSM last-cycle RMSE of [C_Fx, C_Fy].
-    pub prssm_cycle_rmse_cf: [f64; 2],
-    /// LRQSM last-cycle RMSE of [C_Fx, C_Fy].
-    pub lrqsm_cycle_rmse_cf: [f64; 2],
-    /// PR-SSM overall standardized RMSE from `start_sample` on.
-    pub prssm_overall_rmse: f64,
-    /// LRQSM overall standardized RMSE from `start_sample` on.
-    pub lrqsm_overall_rmse: f64,
+    /// Each model's results, in the evaluation's model order.
+    pub models: Vec<TrajectoryModelMetrics>,
 }
 
 /// The influence of one input on one latent state (a row of Fig. 5B).
@@ -165,6 +181,8 @@ pub struct AuthorityFinding {
 /// Everything [`evaluate`] computes (written as `metrics.json`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct EvaluationReport {
+    /// [`METRICS_VERSION`].
+    pub version: u32,
     /// Dataset description (file name or origin).
     pub dataset: String,
     /// Training trajectories.
@@ -173,19 +191,25 @@ pub struct EvaluationReport {
     pub n_test: usize,
     /// Settings.
     pub options: EvalOptions,
-    /// PR-SSM accuracy.
-    pub prssm: ModelMetrics,
-    /// LRQSM accuracy.
-    pub lrqsm: ModelMetrics,
-    /// Test RMSE ratio PR-SSM / LRQSM per output (training set when there is no test set).
+    /// Each model's accuracy, in the order given.
+    pub models: Vec<ModelMetrics>,
+    /// Test RMSE ratio first / second model per output (training set when there is no test
+    /// set; empty with one model).
     pub rmse_ratio: Vec<f64>,
     /// Per-trajectory results.
     pub trajectories: Vec<TrajectoryMetrics>,
-    /// Influence of AoA and a_x on the output states x1..x5 (paper: AoA near zero lag, a_x
-    /// about 0.2 cycle).
+    /// Influence of AoA and a_x on the output states x1..x5 of the first model with latent
+    /// states (paper: AoA near zero lag, a_x about 0.2 cycle); empty without one.
     pub authority_findings: Vec<AuthorityFinding>,
     /// Files written, relative to the output folder.
     pub files: Vec<String>,
+}
+
+impl EvaluationReport {
+    /// The metrics of the model with `key`.
+    pub fn model(&self, key: &str) -> Option<&ModelMetrics> {
+        self.models.iter().find(|m| m.key == key)
+    }
 }
 
 /// Text and settings the caller adds to the HTML report.
@@ -201,32 +225,137 @@ pub struct ReportContext {
     pub config: serde_json::Value,
 }
 
-/// Evaluates both models on `ds` and writes into `out_dir`: `metrics.json`
-/// ([`EvaluationReport`]), `trajectories.csv`, `authority_summary.{json,csv}`,
-/// `authority_peaks.csv`, `predictions.npz`, the figures (`fig2c_wing_motion.png`,
-/// `fig3_time_histories.png`, `fig4a_histograms_{train,test}.png`, `fig4b_cycle_averages.png`,
-/// `fig5a_hdr.png`, `fig5a_scatter_x1.png`, `fig5b_summary.png`, `training_*.png`) and
+/// Evaluates `models` on `ds` and writes into `out_dir`: `metrics.json`
+/// ([`EvaluationReport`]), `trajectories.csv`, `predictions.npz`, with a latent-state model
+/// `authority_summary.{json,csv}` and `authority_peaks.csv`, the figures
+/// (`fig2c_wing_motion.png`, `fig3_time_histories.png`, `fig4a_histograms_{train,test}.png`,
+/// `fig4b_cycle_averages.png`, with a latent-state model `fig5a_hdr.png`,
+/// `fig5a_scatter_x1.png`, `fig5b_summary.png`, with a training history `training_*.png`) and
 /// `report.html`. Every file is written atomically.
 ///
 /// # Errors
-/// A dataset without outputs or training trajectories, models that do not fit it, trajectories
-/// without a full stroke cycle, analysis and I/O errors — each naming its item.
+/// No model, a dataset without outputs or training trajectories, models that do not fit it,
+/// trajectories without a full stroke cycle, analysis and I/O errors — each naming its item.
 #[allow(clippy::too_many_arguments)]
 pub fn evaluate(
     ds: &Dataset,
     dataset_label: &str,
-    prssm: &PrssmModel,
-    lrqsm: &LrqsmModel,
+    models: &[&dyn LoadModel],
     opts: &EvalOptions,
     context: &ReportContext,
     out_dir: &Path,
     progress: &dyn Progress,
 ) -> Result<EvaluationReport> {
+    check(ds, models, opts)?;
+    std::fs::create_dir_all(out_dir).map_err(|source| JobError::Io {
+        path: out_dir.to_path_buf(),
+        source,
+    })?;
+    let mut predictions = Vec::with_capacity(models.len());
+    for m in models {
+        progress.start(&format!("predict {}", m.name()), ds.len() as u64);
+        predictions.push(predict_all(*m, ds, progress)?);
+        progress.finish("");
+    }
+
+    progress.start("analyse", 0);
+    let prep = prepare(ds, &predictions)?;
+    let n_train = ds.n_train.min(ds.len());
+    let sets = Sets::new(&prep, n_train);
+    let metrics = models
+        .iter()
+        .enumerate()
+        .map(|(k, m)| model_metrics(m.name(), m.key(), k, &sets, opts))
+        .collect::<Result<Vec<_>>>()?;
+    let rmse_ratio = match &metrics[..] {
+        [a, b, ..] => a
+            .test_or_train()
+            .rmse_standardized
+            .iter()
+            .zip(&b.test_or_train().rmse_standardized)
+            .map(|(a, b)| a / b)
+            .collect(),
+        _ => Vec::new(),
+    };
+    let trajectories = trajectory_metrics(ds, models, &prep, n_train, opts)?;
+    let latent = models.iter().position(|m| m.n_latent() > 0);
+    let authority = latent
+        .map(|k| authority(ds, &predictions[k], models[k].n_latent(), &prep, opts))
+        .transpose()?;
+    progress.finish("");
+
+    progress.start("write outputs", 0);
+    let mut files = Vec::new();
+    let mut file = |name: &str| {
+        files.push(name.to_string());
+        out_dir.join(name)
+    };
+    if let Some(a) = &authority {
+        a.write(
+            &file("authority_summary.json"),
+            &file("authority_summary.csv"),
+            &file("authority_peaks.csv"),
+        )?;
+    }
+    write_text(
+        &file("trajectories.csv"),
+        &trajectories_csv(models, &trajectories),
+    )?;
+    write_predictions(&file("predictions.npz"), ds, models, &predictions)?;
+    let figures = draw_figures(
+        ds,
+        models,
+        &prep,
+        &sets,
+        &trajectories,
+        authority.as_ref(),
+        opts,
+        &mut file,
+    )?;
+    let report = EvaluationReport {
+        version: METRICS_VERSION,
+        dataset: dataset_label.to_string(),
+        n_train,
+        n_test: sets.test.len(),
+        options: opts.clone(),
+        models: metrics,
+        rmse_ratio,
+        trajectories,
+        authority_findings: authority.map(|a| a.findings).unwrap_or_default(),
+        files: {
+            let mut f = files.clone();
+            f.retain(|f| figures.written(f));
+            f.push("metrics.json".into());
+            f.push("report.html".into());
+            f
+        },
+    };
+    write_json(&out_dir.join("metrics.json"), &report)?;
+    let html = html_report(&report, context, figures, models);
+    let p_html = out_dir.join("report.html");
+    html.write(&p_html)
+        .map_err(analysis(p_html.display().to_string()))?;
+    progress.finish("");
+    Ok(report)
+}
+
+/// Checks the inputs once, before any prediction.
+fn check(ds: &Dataset, models: &[&dyn LoadModel], opts: &EvalOptions) -> Result<()> {
     ds.validate()?;
     if !ds.has_outputs() {
         return Err(flapssm_data::DatasetError::NoOutputs.into());
     }
-    let stats = ds.standardization()?;
+    let n_train = ds.n_train.min(ds.len());
+    if n_train == 0 {
+        return Err(flapssm_data::DatasetError::NoTrainingData { n_train }.into());
+    }
+    if models.is_empty() {
+        return Err(JobError::Mismatch {
+            what: "models to evaluate".into(),
+            expected: "at least one".into(),
+            found: "none".into(),
+        });
+    }
     let n = ds.n_samples();
     if opts.start_sample >= n {
         return Err(JobError::Mismatch {
@@ -235,20 +364,14 @@ pub fn evaluate(
             found: opts.start_sample.to_string(),
         });
     }
-    std::fs::create_dir_all(out_dir).map_err(|source| JobError::Io {
-        path: out_dir.to_path_buf(),
-        source,
-    })?;
+    Ok(())
+}
 
-    progress.start("predict PR-SSM", ds.len() as u64);
-    let pp = predict_prssm(prssm, ds, opts.particles, opts.seed, progress)?;
-    progress.finish("");
-    let lq = predict_lrqsm(lrqsm, ds)?;
-    let dx = prssm.config.n_state;
-
-    progress.start("analyse", 0);
-    let fluid = &ds.meta.fluid;
-    let wing = &ds.meta.wing;
+/// Each trajectory's window and its measured and predicted tables (standardized and as
+/// coefficients).
+fn prepare(ds: &Dataset, predictions: &[Vec<ModelPrediction>]) -> Result<Vec<Prepared>> {
+    let stats = ds.standardization()?;
+    let (fluid, wing) = (&ds.meta.fluid, &ds.meta.wing);
     let z = |y: &[f64]| -> Vec<f64> {
         y.chunks_exact(5)
             .flat_map(|r| (0..5).map(move |j| (r[j] - stats.mean_y[j]) / stats.std_y[j]))
@@ -277,60 +400,85 @@ pub fn evaluate(
         let coef = |v: &[f64]| -> Result<Vec<f64>> {
             coefficients_of(rows(v, 5, &what)?, &scales).map_err(analysis(what.clone()))
         };
-        let std_raw: Vec<f64> = pp[i].output_var.iter().map(|v| v.max(0.0).sqrt()).collect();
+        let models = predictions
+            .iter()
+            .map(|p| {
+                let p = &p[i];
+                let std_c = p
+                    .var
+                    .as_ref()
+                    .map(|var| coef(&var.iter().map(|v| v.max(0.0).sqrt()).collect::<Vec<_>>()))
+                    .transpose()?;
+                Ok(ModelTables {
+                    z: z(&p.mean),
+                    c: coef(&p.mean)?,
+                    std_c,
+                })
+            })
+            .collect::<Result<_>>()?;
         prep.push(Prepared {
             window,
             measured_z: z(measured),
             measured_c: coef(measured)?,
-            prssm_z: z(&pp[i].output_mean),
-            prssm_c: coef(&pp[i].output_mean)?,
-            prssm_std_c: coef(&std_raw)?,
-            lrqsm_z: z(&lq[i]),
-            lrqsm_c: coef(&lq[i])?,
+            models,
         });
     }
-    let n_train = ds.n_train.min(ds.len());
-    if n_train == 0 {
-        return Err(flapssm_data::DatasetError::NoTrainingData { n_train }.into());
-    }
-    let train: Vec<&Prepared> = prep[..n_train].iter().collect();
-    let test: Vec<&Prepared> = prep[n_train..].iter().collect();
-    let all: Vec<&Prepared> = prep.iter().collect();
-    fn pick_p(p: &Prepared) -> (&[f64], &[f64]) {
-        (&p.prssm_z, &p.prssm_c)
-    }
-    fn pick_l(p: &Prepared) -> (&[f64], &[f64]) {
-        (&p.lrqsm_z, &p.lrqsm_c)
-    }
-    let model_metrics = |name: &str, pick: Pick<'_>| {
-        Ok::<_, JobError>(ModelMetrics {
-            model: name.into(),
-            train: split_metrics(&train, pick, opts, &format!("{name} training metrics"))?,
-            test: if test.is_empty() {
-                None
-            } else {
-                Some(split_metrics(
-                    &test,
-                    pick,
-                    opts,
-                    &format!("{name} test metrics"),
-                )?)
-            },
-            cycle_average_error_interval_all: cycle_errors(&all, &|p| pick(p).1)?
-                .intervals(opts.level)
-                .map_err(analysis(format!("{name} cycle averages")))?,
-        })
-    };
-    let pm = model_metrics("PR-SSM", &pick_p)?;
-    let lm = model_metrics("LRQSM", &pick_l)?;
-    let (pr, lr) = match (&pm.test, &lm.test) {
-        (Some(a), Some(b)) => (&a.rmse_standardized, &b.rmse_standardized),
-        _ => (&pm.train.rmse_standardized, &lm.train.rmse_standardized),
-    };
-    let rmse_ratio: Vec<f64> = pr.iter().zip(lr).map(|(a, b)| a / b).collect();
+    Ok(prep)
+}
 
+/// The prepared trajectories as training, test and all.
+struct Sets<'p> {
+    train: Vec<&'p Prepared>,
+    test: Vec<&'p Prepared>,
+    all: Vec<&'p Prepared>,
+}
+
+impl<'p> Sets<'p> {
+    fn new(prep: &'p [Prepared], n_train: usize) -> Self {
+        Self {
+            train: prep[..n_train].iter().collect(),
+            test: prep[n_train..].iter().collect(),
+            all: prep.iter().collect(),
+        }
+    }
+}
+
+fn model_metrics(
+    name: &str,
+    key: &str,
+    k: usize,
+    sets: &Sets<'_>,
+    opts: &EvalOptions,
+) -> Result<ModelMetrics> {
+    Ok(ModelMetrics {
+        model: name.into(),
+        key: key.into(),
+        train: split_metrics(&sets.train, k, opts, &format!("{name} training metrics"))?,
+        test: if sets.test.is_empty() {
+            None
+        } else {
+            Some(split_metrics(
+                &sets.test,
+                k,
+                opts,
+                &format!("{name} test metrics"),
+            )?)
+        },
+        cycle_average_error_interval_all: cycle_errors(&sets.all, k)?
+            .intervals(opts.level)
+            .map_err(analysis(format!("{name} cycle averages")))?,
+    })
+}
+
+fn trajectory_metrics(
+    ds: &Dataset,
+    models: &[&dyn LoadModel],
+    prep: &[Prepared],
+    n_train: usize,
+    opts: &EvalOptions,
+) -> Result<Vec<TrajectoryMetrics>> {
     let mut trajectories = Vec::with_capacity(ds.len());
-    for (i, (t, p)) in ds.trajectories.iter().zip(&prep).enumerate() {
+    for (i, (t, p)) in ds.trajectories.iter().zip(prep).enumerate() {
         let what = format!("trajectory {i} metrics");
         let m = rows(&p.measured_c, 5, &what)?;
         let cyc = |v: &[f64]| -> Result<[f64; 2]> {
@@ -356,20 +504,59 @@ pub fn evaluate(
             u_ref_m_s: t.u_ref_m_s,
             period_samples: p.window.duration,
             window_start: p.window.start,
-            prssm_cycle_rmse_cf: cyc(&p.prssm_c)?,
-            lrqsm_cycle_rmse_cf: cyc(&p.lrqsm_c)?,
-            prssm_overall_rmse: overall(&p.prssm_z)?,
-            lrqsm_overall_rmse: overall(&p.lrqsm_z)?,
+            models: models
+                .iter()
+                .zip(&p.models)
+                .map(|(m, q)| {
+                    Ok(TrajectoryModelMetrics {
+                        model: m.key().into(),
+                        cycle_rmse_cf: cyc(&q.c)?,
+                        overall_rmse: overall(&q.z)?,
+                    })
+                })
+                .collect::<Result<_>>()?,
         });
     }
+    Ok(trajectories)
+}
 
-    // Control authority on the latent means, every trajectory, transient dropped.
+/// The control-authority analysis of one model's latent states.
+struct Authority {
+    table: PeakTable,
+    summary: AuthoritySummary,
+    state_names: Vec<String>,
+    input_names: Vec<String>,
+    findings: Vec<AuthorityFinding>,
+}
+
+impl Authority {
+    fn write(&self, summary_json: &Path, summary_csv: &Path, peaks_csv: &Path) -> Result<()> {
+        self.summary
+            .write_json(summary_json)
+            .map_err(analysis(summary_json.display().to_string()))?;
+        self.summary
+            .write_csv(summary_csv)
+            .map_err(analysis(summary_csv.display().to_string()))?;
+        self.table
+            .write_csv(peaks_csv, &self.state_names, &self.input_names)
+            .map_err(analysis(peaks_csv.display().to_string()))
+    }
+}
+
+/// Control authority on the latent means, every trajectory, transient dropped.
+fn authority(
+    ds: &Dataset,
+    predictions: &[ModelPrediction],
+    dx: usize,
+    prep: &[Prepared],
+    opts: &EvalOptions,
+) -> Result<Authority> {
     let s0 = opts.start_sample;
     let auth_traj: Vec<AuthorityTrajectory<'_>> = ds
         .trajectories
         .iter()
-        .zip(&pp)
-        .zip(&prep)
+        .zip(predictions)
+        .zip(prep)
         .map(|((t, p), q)| {
             Ok(AuthorityTrajectory {
                 inputs: rows(&t.inputs.as_flattened()[s0 * 7..], 7, "authority inputs")?,
@@ -388,11 +575,11 @@ pub fn evaluate(
         &opts.authority,
     )
     .map_err(analysis("control-authority summary"))?;
-    let mut authority_findings = Vec::new();
+    let mut findings = Vec::new();
     for input in [0usize, 2] {
         for (state, state_name) in state_names.iter().enumerate().take(5) {
             let s = summary.pair(state, input);
-            authority_findings.push(AuthorityFinding {
+            findings.push(AuthorityFinding {
                 input: input_names[input].clone(),
                 state: state_name.clone(),
                 median_abs_r: s.median_abs_r,
@@ -403,47 +590,35 @@ pub fn evaluate(
             });
         }
     }
-    progress.finish("");
+    Ok(Authority {
+        table,
+        summary,
+        state_names,
+        input_names,
+        findings,
+    })
+}
 
-    // Files.
-    progress.start("write outputs", 0);
-    let mut files = Vec::new();
-    let mut file = |name: &str| {
-        files.push(name.to_string());
-        out_dir.join(name)
-    };
-    let p_json = file("authority_summary.json");
-    summary
-        .write_json(&p_json)
-        .map_err(analysis(p_json.display().to_string()))?;
-    let p_csv = file("authority_summary.csv");
-    summary
-        .write_csv(&p_csv)
-        .map_err(analysis(p_csv.display().to_string()))?;
-    let p_peaks = file("authority_peaks.csv");
-    table
-        .write_csv(&p_peaks, &state_names, &input_names)
-        .map_err(analysis(p_peaks.display().to_string()))?;
-    write_text(&file("trajectories.csv"), &trajectories_csv(&trajectories))?;
-    write_predictions(&file("predictions.npz"), ds, &pp, &lq, dx)?;
-
-    // Figures.
+/// Draws every figure; `file` names (and records) each file.
+#[allow(clippy::too_many_arguments)]
+fn draw_figures(
+    ds: &Dataset,
+    models: &[&dyn LoadModel],
+    prep: &[Prepared],
+    sets: &Sets<'_>,
+    trajectories: &[TrajectoryMetrics],
+    authority: Option<&Authority>,
+    opts: &EvalOptions,
+    file: &mut dyn FnMut(&str) -> PathBuf,
+) -> Result<ReportFigures> {
+    let n = ds.n_samples();
+    let wing = &ds.meta.wing;
     let examples = example_trajectories(ds, opts.example_trajectories);
-    let mut fig = |name: &str| file(name);
-    let f_2c = fig("fig2c_wing_motion.png");
-    let f_3 = fig("fig3_time_histories.png");
-    let f_4a_train = fig("fig4a_histograms_train.png");
-    let f_4a_test = fig("fig4a_histograms_test.png");
-    let f_4b = fig("fig4b_cycle_averages.png");
-    let f_5a = fig("fig5a_hdr.png");
-    let f_5s = fig("fig5a_scatter_x1.png");
-    let f_5b = fig("fig5b_summary.png");
-    let f_loss = fig("training_loss.png");
-    let f_rmse = fig("training_rmse.png");
     let labels: Vec<String> = examples
         .iter()
         .map(|&i| example_title(ds, i, &trajectories[i]))
         .collect();
+    let f_2c = file("fig2c_wing_motion.png");
     let paths: Vec<wing3d::WingPath<'_>> = examples
         .iter()
         .zip(&labels)
@@ -459,117 +634,101 @@ pub fn evaluate(
         ..Default::default()
     };
     wing3d::wing_motion_3d(&f_2c, &paths, &geom).map_err(analysis("Fig. 2C"))?;
-    draw_fig3(&f_3, ds, &prep, &examples, &labels)?;
-    let names5: Vec<&str> = COEFFICIENT_LABELS.to_vec();
+    let f_3 = file("fig3_time_histories.png");
+    draw_fig3(&f_3, ds, models, prep, &examples, &labels)?;
+
     let edges = Histogram::uniform_edges(-1.1, 1.1, 0.01);
     let out_names = OUTPUT_NAMES
         .iter()
         .map(|s| format!("{s}/σ"))
         .collect::<Vec<_>>();
     let out_refs: Vec<&str> = out_names.iter().map(String::as_str).collect();
-    for (path, set, label) in [(&f_4a_train, &train, "train"), (&f_4a_test, &test, "test")] {
+    let mut f_4a = Vec::new();
+    for (set, label) in [(&sets.train, "train"), (&sets.test, "test")] {
         if set.is_empty() {
             continue;
         }
-        let ep = pooled(set, &|p| &p.prssm_z, s0)?;
-        let el = pooled(set, &|p| &p.lrqsm_z, s0)?;
-        let lp = format!("PR-SSM {label}");
-        let ll = format!("LRQSM {label}");
-        pe::error_histograms(
-            path,
-            &out_refs,
-            &[
-                pe::ModelErrors {
-                    label: &lp,
-                    errors: &ep.errors,
-                },
-                pe::ModelErrors {
-                    label: &ll,
-                    errors: &el.errors,
-                },
-            ],
-            &edges,
-            opts.level,
-        )
-        .map_err(analysis("Fig. 4A"))?;
+        let path = file(&format!("fig4a_histograms_{label}.png"));
+        let errors = (0..models.len())
+            .map(|k| pooled(set, k, opts.start_sample))
+            .collect::<Result<Vec<_>>>()?;
+        let labels: Vec<String> = models
+            .iter()
+            .map(|m| format!("{} {label}", m.name()))
+            .collect();
+        let series: Vec<pe::ModelErrors<'_>> = labels
+            .iter()
+            .zip(&errors)
+            .map(|(l, e)| pe::ModelErrors {
+                label: l,
+                errors: &e.errors,
+            })
+            .collect();
+        pe::error_histograms(&path, &out_refs, &series, &edges, opts.level)
+            .map_err(analysis("Fig. 4A"))?;
+        f_4a.push(path);
     }
-    let cp = cycle_errors(&all, &|p| &p.prssm_c)?;
-    let cl = cycle_errors(&all, &|p| &p.lrqsm_c)?;
+    let f_4b = file("fig4b_cycle_averages.png");
+    let cycles = (0..models.len())
+        .map(|k| cycle_errors(&sets.all, k))
+        .collect::<Result<Vec<_>>>()?;
+    let series: Vec<pe::ModelCycleAverages<'_>> = models
+        .iter()
+        .zip(&cycles)
+        .map(|(m, c)| pe::ModelCycleAverages {
+            label: m.name(),
+            observed: &c.observed,
+            error: &c.error,
+        })
+        .collect();
     pe::cycle_average_scatter(
         &f_4b,
-        &names5,
-        &[
-            pe::ModelCycleAverages {
-                label: "PR-SSM",
-                observed: &cp.observed,
-                error: &cp.error,
-            },
-            pe::ModelCycleAverages {
-                label: "LRQSM",
-                observed: &cl.observed,
-                error: &cl.error,
-            },
-        ],
+        &COEFFICIENT_LABELS,
+        &series,
         Some(&[0.75, 0.75, 2.0, 2.0, 2.0]),
         opts.level,
     )
     .map_err(analysis("Fig. 4B"))?;
-    pa::hdr_contours(&f_5a, &summary).map_err(analysis("Fig. 5Ai"))?;
-    pa::pair_scatter(&f_5s, &table, &summary, 0).map_err(analysis("Fig. 5Aii"))?;
-    pa::summary_grid(&f_5b, &summary).map_err(analysis("Fig. 5B"))?;
-    let have_curves = draw_training(&f_loss, &f_rmse, prssm)?;
-    if !have_curves {
-        files.retain(|f| !f.starts_with("training_"));
-    }
-    if test.is_empty() {
-        files.retain(|f| f != "fig4a_histograms_test.png");
-    }
-
-    let report = EvaluationReport {
-        dataset: dataset_label.to_string(),
-        n_train,
-        n_test: test.len(),
-        options: opts.clone(),
-        prssm: pm,
-        lrqsm: lm,
-        rmse_ratio,
-        trajectories,
-        authority_findings,
-        files: {
-            let mut f = files.clone();
-            f.push("metrics.json".into());
-            f.push("report.html".into());
-            f
-        },
+    let fig5 = match authority {
+        Some(a) => {
+            let (f_5a, f_5s, f_5b) = (
+                file("fig5a_hdr.png"),
+                file("fig5a_scatter_x1.png"),
+                file("fig5b_summary.png"),
+            );
+            pa::hdr_contours(&f_5a, &a.summary).map_err(analysis("Fig. 5Ai"))?;
+            pa::pair_scatter(&f_5s, &a.table, &a.summary, 0).map_err(analysis("Fig. 5Aii"))?;
+            pa::summary_grid(&f_5b, &a.summary).map_err(analysis("Fig. 5B"))?;
+            Some((f_5a, f_5s, f_5b))
+        }
+        None => None,
     };
-    write_json(&out_dir.join("metrics.json"), &report)?;
-    let html = html_report(
-        &report,
-        context,
-        ReportFigures {
-            f_2c,
-            f_3,
-            f_4a_train,
-            f_4a_test: (!test.is_empty()).then_some(f_4a_test),
-            f_4b,
-            f_5a,
-            f_5s,
-            f_5b,
-            training: have_curves.then_some((f_loss, f_rmse)),
-        },
-        prssm,
-        lrqsm,
-    );
-    let p_html = out_dir.join("report.html");
-    html.write(&p_html)
-        .map_err(analysis(p_html.display().to_string()))?;
-    progress.finish("");
-    Ok(report)
+    let training = models
+        .iter()
+        .find_map(|m| m.training_history().map(|h| (m.name(), h)));
+    let training = match training {
+        Some((name, history)) => {
+            let (f_loss, f_rmse) = (file("training_loss.png"), file("training_rmse.png"));
+            draw_training(&f_loss, &f_rmse, name, history)?.then_some((f_loss, f_rmse))
+        }
+        None => None,
+    };
+    Ok(ReportFigures {
+        f_2c,
+        f_3,
+        f_4a_train: f_4a.first().cloned(),
+        f_4a_test: f_4a.get(1).cloned(),
+        f_4b,
+        fig5,
+        training,
+    })
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::models::lrqsm::LrqsmLoadModel;
+    use crate::models::prssm::PrssmLoadModel;
     use crate::progress::NoProgress;
     use crate::train::{TrainingOptions, train_prssm};
     use flapssm_qs::InterceptMode;
@@ -613,29 +772,34 @@ mod tests {
             },
             ..EvalOptions::default()
         };
+        let prssm = PrssmLoadModel::new(&fit.best, &ds, eo.particles, eo.seed).unwrap();
+        let lq = LrqsmLoadModel::new(&lrqsm).unwrap();
         let r = evaluate(
             &ds,
             "tiny",
-            &fit.best,
-            &lrqsm,
+            &[&prssm, &lq],
             &eo,
             &ReportContext::default(),
             &dir,
             &NoProgress,
         )
         .unwrap();
-        let lt = r.lrqsm.test.as_ref().unwrap();
+        assert_eq!(
+            r.models.iter().map(|m| m.key.as_str()).collect::<Vec<_>>(),
+            ["prssm", "lrqsm"]
+        );
+        let (rp, rl) = (r.model("prssm").unwrap(), r.model("lrqsm").unwrap());
+        let lt = rl.test.as_ref().unwrap();
         let qt = q.rmse_test.as_ref().unwrap();
         for j in 0..5 {
             assert!((lt.rmse_standardized[j] - qt.standardized[j]).abs() < 1e-10);
             assert!(
-                (r.lrqsm.train.rmse_standardized[j]
-                    - q.rmse_train.as_ref().unwrap().standardized[j])
+                (rl.train.rmse_standardized[j] - q.rmse_train.as_ref().unwrap().standardized[j])
                     .abs()
                     < 1e-10
             );
         }
-        let pt = r.prssm.test.as_ref().unwrap();
+        let pt = rp.test.as_ref().unwrap();
         let ms: f64 = pt.rmse_standardized.iter().map(|v| v * v).sum::<f64>() / 5.0;
         assert!((pt.overall_rmse_standardized - ms.sqrt()).abs() < 1e-12);
         for j in 0..5 {
@@ -653,6 +817,46 @@ mod tests {
         for f in &r.files {
             assert!(dir.join(f).exists(), "{f}");
         }
+        let csv = std::fs::read_to_string(dir.join("trajectories.csv")).unwrap();
+        assert!(csv.lines().next().unwrap().ends_with(
+            "prssm_rmse_cfx,prssm_rmse_cfy,lrqsm_rmse_cfx,lrqsm_rmse_cfy,\
+             prssm_overall_rmse_std,lrqsm_overall_rmse_std"
+        ));
         std::fs::remove_dir_all(&dir).ok();
+
+        // One model without latent states: no authority analysis, no Fig. 5, no ratio.
+        let arx = lq;
+        let dir = std::env::temp_dir().join(format!("flapssm-one-model-{}", std::process::id()));
+        let r = evaluate(
+            &ds,
+            "tiny",
+            &[&arx],
+            &eo,
+            &ReportContext::default(),
+            &dir,
+            &NoProgress,
+        )
+        .unwrap();
+        assert!(r.authority_findings.is_empty() && r.rmse_ratio.is_empty());
+        assert!(
+            !r.files
+                .iter()
+                .any(|f| f.starts_with("fig5") || f.starts_with("authority"))
+        );
+        for f in &r.files {
+            assert!(dir.join(f).exists(), "{f}");
+        }
+        std::fs::remove_dir_all(&dir).ok();
+        let e = evaluate(
+            &ds,
+            "tiny",
+            &[],
+            &eo,
+            &ReportContext::default(),
+            &dir,
+            &NoProgress,
+        )
+        .unwrap_err();
+        assert!(e.to_string().contains("models to evaluate"), "{e}");
     }
 }

@@ -1,0 +1,139 @@
+//! Load models: wing kinematics in, the five loads out, one trajectory at a time.
+//!
+//! [`LoadModel`] is what evaluation, the report and the demo's summary need of a model; [`Fit`]
+//! turns validated settings into one (linfa's `Fit`). Evaluation takes any number of models,
+//! so a new baseline is one new file implementing both.
+//!
+//! | model | file | fitted by |
+//! |---|---|---|
+//! | PR-SSM | [`prssm`] | particle ELBO with Adam ([`crate::train`]) |
+//! | LRQSM | [`lrqsm`] | elastic net with cross-validation (`flapssm-qs`) |
+
+use flapssm_data::{Dataset, Trajectory};
+use flapssm_prssm::train::EpochRecord;
+
+use crate::error::{JobError, Result};
+use crate::progress::Progress;
+
+pub mod lrqsm;
+pub mod prssm;
+
+/// Loads a model writes for one trajectory of `n` samples: row-major `n × 5` tables in N and
+/// N·mm (variances in N², (N·mm)²), latent means `n × n_latent`.
+pub struct LoadPrediction<'a> {
+    /// Output means, `n × 5`.
+    pub mean: &'a mut [f64],
+    /// Output variances, `n × 5`, for a model with [`LoadModel::has_variance`].
+    pub var: Option<&'a mut [f64]>,
+    /// Latent means, `n × n_latent`, for a model with latent states.
+    pub latent_mean: Option<&'a mut [f64]>,
+}
+
+/// A model of the wing's loads.
+pub trait LoadModel: Sync {
+    /// Display name ("PR-SSM", "LRQSM", …).
+    fn name(&self) -> &str;
+    /// File-safe identifier ("prssm", "lrqsm", …): prefixes of its columns and arrays.
+    fn key(&self) -> &str;
+    /// A summary of its parameters and settings, for the report.
+    fn parameters(&self) -> serde_json::Value;
+    /// Whether [`LoadModel::predict_into`] writes output variances.
+    fn has_variance(&self) -> bool {
+        false
+    }
+    /// Latent states per sample (0: none).
+    fn n_latent(&self) -> usize {
+        0
+    }
+    /// The per-epoch training history, for a model trained by epochs.
+    fn training_history(&self) -> Option<&[EpochRecord]> {
+        None
+    }
+    /// Predicts trajectory `index` (`trajectory`) open loop into `out`, whose tables have
+    /// `trajectory`'s sample count. `index` seeds any random draws, so the same model predicts
+    /// the same trajectory identically whatever else is predicted.
+    ///
+    /// # Errors
+    /// [`JobError::Mismatch`] for buffers of the wrong length; the model's own errors naming
+    /// the trajectory.
+    fn predict_into(
+        &self,
+        index: usize,
+        trajectory: &Trajectory,
+        out: LoadPrediction<'_>,
+    ) -> Result<()>;
+}
+
+/// Validated settings that fit a [`LoadModel`] on a dataset's training trajectories.
+pub trait Fit {
+    /// The fitted model.
+    type Model: LoadModel;
+    /// Fits on `ds`'s training trajectories.
+    ///
+    /// # Errors
+    /// The model's fitting errors, naming the dataset or trajectory.
+    fn fit(&self, ds: &Dataset, progress: &dyn Progress) -> Result<Self::Model>;
+}
+
+/// One model's open-loop prediction of one trajectory (owned tables of [`LoadPrediction`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ModelPrediction {
+    /// Output means, `n × 5` (N, N·mm).
+    pub mean: Vec<f64>,
+    /// Output variances, `n × 5`, when the model has them.
+    pub var: Option<Vec<f64>>,
+    /// Latent means, `n × n_latent` (empty without latent states).
+    pub latent_mean: Vec<f64>,
+}
+
+/// Predicts every trajectory of `ds` with `model` (in parallel with feature `parallel`;
+/// results do not depend on threading). `progress.advance(1)` per trajectory.
+///
+/// # Errors
+/// The first trajectory's error.
+pub fn predict_all(
+    model: &dyn LoadModel,
+    ds: &Dataset,
+    progress: &dyn Progress,
+) -> Result<Vec<ModelPrediction>> {
+    let one = |(i, t): (usize, &Trajectory)| -> Result<ModelPrediction> {
+        let n = t.inputs.len();
+        let mut p = ModelPrediction {
+            mean: vec![0.0; n * 5],
+            var: model.has_variance().then(|| vec![0.0; n * 5]),
+            latent_mean: vec![0.0; n * model.n_latent()],
+        };
+        model.predict_into(
+            i,
+            t,
+            LoadPrediction {
+                mean: &mut p.mean,
+                var: p.var.as_deref_mut(),
+                latent_mean: (model.n_latent() > 0).then_some(&mut p.latent_mean[..]),
+            },
+        )?;
+        progress.advance(1);
+        Ok(p)
+    };
+    #[cfg(feature = "parallel")]
+    {
+        use rayon::prelude::*;
+        ds.trajectories.par_iter().enumerate().map(one).collect()
+    }
+    #[cfg(not(feature = "parallel"))]
+    {
+        ds.trajectories.iter().enumerate().map(one).collect()
+    }
+}
+
+/// Checks that `buffer` holds `n × width` values.
+pub(crate) fn check_buffer(what: &str, buffer: &[f64], n: usize, width: usize) -> Result<()> {
+    if buffer.len() != n * width {
+        return Err(JobError::Mismatch {
+            what: format!("{what} buffer"),
+            expected: format!("{n} × {width} = {} values", n * width),
+            found: buffer.len().to_string(),
+        });
+    }
+    Ok(())
+}
