@@ -112,7 +112,10 @@ fn tiny_demo_evaluate_and_sweep() {
         "5",
     ]);
     let m2 = json(&ev.join("metrics.json"));
-    assert_eq!(m2["models"], m["models"]);
+    // The demo also evaluated the ARX baseline; evaluate was given the PR-SSM and the LRQSM.
+    assert_eq!(m2["models"][0], m["models"][0]);
+    assert_eq!(m2["models"][1], m["models"][1]);
+    assert_eq!(m["models"][2]["key"], "arx");
 
     // `predict` with the same seed draws what `evaluate` and the demo drew (one seed rule).
     let pred = tmp.path().join("pred.npz");

@@ -35,9 +35,10 @@ use crate::evaluate::{
     versions,
 };
 use crate::files::{load_json, save_json};
-use crate::models::LoadModel;
+use crate::models::arx::ArxSettings;
 use crate::models::lrqsm::LrqsmLoadModel;
 use crate::models::prssm::PrssmLoadModel;
+use crate::models::{Fit, LoadModel};
 use crate::progress::Progress;
 use crate::train::{TrainingOptions, train_prssm};
 use flapssm_analysis::stats::{Interval, median};
@@ -68,6 +69,8 @@ pub struct DemoConfig {
     pub lrqsm: EnetOptions,
     /// PR-SSM training.
     pub training: TrainingOptions,
+    /// The ARX baseline (fitted in the evaluation stage; least squares, milliseconds).
+    pub arx: ArxSettings,
     /// Evaluation.
     pub evaluation: EvalOptions,
 }
@@ -103,6 +106,7 @@ impl DemoConfig {
                 seed,
                 ..TrainingOptions::default()
             },
+            arx: ArxSettings::default(),
             evaluation: EvalOptions {
                 seed,
                 ..EvalOptions::default()
@@ -126,6 +130,7 @@ impl DemoConfig {
                 seed,
                 ..TrainingOptions::default()
             },
+            arx: ArxSettings::default(),
             evaluation: EvalOptions {
                 seed,
                 ..EvalOptions::default()
@@ -295,6 +300,7 @@ pub fn run_demo(
 ) -> Result<DemoSummary> {
     let t_all = Instant::now();
     let plan = cfg.training.check()?;
+    let arx_fit = cfg.arx.check()?;
     std::fs::create_dir_all(dir).map_err(|source| JobError::Io {
         path: dir.to_path_buf(),
         source,
@@ -418,7 +424,7 @@ pub fn run_demo(
     let metrics_path = eval_dir.join("metrics.json");
     let report_path = eval_dir.join("report.html");
     let k_ev = serde_json::json!({
-        "lrqsm": k_lq, "prssm": k_pm,
+        "lrqsm": k_lq, "prssm": k_pm, "arx": json(&cfg.arx),
         "evaluation": json(&cfg.evaluation), "metrics_version": METRICS_VERSION,
     });
     let timings_so_far: Vec<(String, String)> = run
@@ -443,14 +449,15 @@ pub fn run_demo(
         |p| {
             let ctx = ReportContext {
                 title: format!("flapssm demo ({} configuration, seed {})", cfg.name, cfg.seed),
-                intro: "Virtual flapping wing simulated with flapssm; LRQSM (elastic net on quasi-steady features) and PR-SSM trained on the training trajectories and evaluated open loop on all trajectories.".into(),
+                intro: "Virtual flapping wing simulated with flapssm; PR-SSM, LRQSM (elastic net on quasi-steady features) and an ARX baseline (least squares on lagged inputs) fitted on the training trajectories and evaluated open loop on all trajectories.".into(),
                 headline: timings_so_far,
                 config: json(cfg),
             };
             let e = &cfg.evaluation;
             let prssm = PrssmLoadModel::new(&prssm, &ds, e.particles, e.seed)?;
             let lrqsm = LrqsmLoadModel::new(&lrqsm)?;
-            let models: [&dyn LoadModel; 2] = [&prssm, &lrqsm];
+            let arx = arx_fit.fit(&ds, p)?;
+            let models: [&dyn LoadModel; 3] = [&prssm, &lrqsm, &arx];
             evaluate(
                 &ds,
                 &ds_path.display().to_string(),

@@ -6,18 +6,19 @@ use anyhow::Context;
 use clap::Args;
 use flapssm_data::Dataset;
 use flapssm_jobs::evaluate::{EvalOptions, ReportContext, evaluate};
-use flapssm_jobs::models::LoadModel;
+use flapssm_jobs::models::arx::ArxSettings;
 use flapssm_jobs::models::lrqsm::LrqsmLoadModel;
 use flapssm_jobs::models::prssm::PrssmLoadModel;
+use flapssm_jobs::models::{Fit, LoadModel};
 use flapssm_prssm::PrssmModel;
 use flapssm_qs::LrqsmModel;
 
 use crate::progress::Bars;
 
-/// Evaluate load models (a PR-SSM, an LRQSM) on a dataset's training and
+/// Evaluate load models (a PR-SSM, an LRQSM, the ARX baseline) on a dataset's training and
 /// test trajectories.
 #[derive(Args)]
-#[command(group(clap::ArgGroup::new("models").required(true).multiple(true).args(["prssm", "lrqsm"])))]
+#[command(group(clap::ArgGroup::new("models").required(true).multiple(true).args(["prssm", "lrqsm", "arx"])))]
 pub struct EvaluateArgs {
     /// Dataset file (flapssm .npz) with outputs.
     #[arg(long)]
@@ -28,6 +29,10 @@ pub struct EvaluateArgs {
     /// LRQSM model file (.json, from `flapssm qs fit`).
     #[arg(long)]
     lrqsm: Option<PathBuf>,
+    /// Also fit and evaluate the ARX baseline (least squares on 21 lags of the inputs, 2 samples
+    /// apart) on the dataset's training trajectories.
+    #[arg(long)]
+    arx: bool,
     /// Output folder.
     #[arg(long)]
     out: PathBuf,
@@ -50,6 +55,7 @@ pub fn run(a: EvaluateArgs) -> anyhow::Result<()> {
         start_sample: a.start_sample,
         ..EvalOptions::default()
     };
+    let arx_fit = a.arx.then(|| ArxSettings::default().check()).transpose()?;
     let ds = Dataset::load(&a.dataset)
         .with_context(|| format!("loading dataset {}", a.dataset.display()))?;
     let prssm = a
@@ -77,11 +83,18 @@ pub fn run(a: EvaluateArgs) -> anyhow::Result<()> {
         .transpose()
         .with_context(|| format!("LRQSM on {}", a.dataset.display()))?;
     let bars = Bars::new();
+    let arx = arx_fit
+        .map(|f| f.fit(&ds, &bars))
+        .transpose()
+        .with_context(|| format!("fitting the ARX baseline on {}", a.dataset.display()))?;
     let mut models: Vec<&dyn LoadModel> = Vec::new();
     if let Some(m) = &prssm {
         models.push(m);
     }
     if let Some(m) = &lrqsm {
+        models.push(m);
+    }
+    if let Some(m) = &arx {
         models.push(m);
     }
     let ctx = ReportContext {
@@ -95,7 +108,7 @@ pub fn run(a: EvaluateArgs) -> anyhow::Result<()> {
             a.dataset.display()
         ),
         config: serde_json::json!({
-            "dataset": a.dataset, "prssm": a.prssm, "lrqsm": a.lrqsm,
+            "dataset": a.dataset, "prssm": a.prssm, "lrqsm": a.lrqsm, "arx": a.arx,
         }),
         ..ReportContext::default()
     };

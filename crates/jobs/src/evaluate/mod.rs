@@ -727,6 +727,8 @@ fn draw_figures(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::models::Fit;
+    use crate::models::arx::ArxSettings;
     use crate::models::lrqsm::LrqsmLoadModel;
     use crate::models::prssm::PrssmLoadModel;
     use crate::progress::NoProgress;
@@ -774,10 +776,15 @@ mod tests {
         };
         let prssm = PrssmLoadModel::new(&fit.best, &ds, eo.particles, eo.seed).unwrap();
         let lq = LrqsmLoadModel::new(&lrqsm).unwrap();
+        let arx = ArxSettings::default()
+            .check()
+            .unwrap()
+            .fit(&ds, &NoProgress)
+            .unwrap();
         let r = evaluate(
             &ds,
             "tiny",
-            &[&prssm, &lq],
+            &[&prssm, &lq, &arx],
             &eo,
             &ReportContext::default(),
             &dir,
@@ -786,7 +793,7 @@ mod tests {
         .unwrap();
         assert_eq!(
             r.models.iter().map(|m| m.key.as_str()).collect::<Vec<_>>(),
-            ["prssm", "lrqsm"]
+            ["prssm", "lrqsm", "arx"]
         );
         let (rp, rl) = (r.model("prssm").unwrap(), r.model("lrqsm").unwrap());
         let lt = rl.test.as_ref().unwrap();
@@ -819,13 +826,12 @@ mod tests {
         }
         let csv = std::fs::read_to_string(dir.join("trajectories.csv")).unwrap();
         assert!(csv.lines().next().unwrap().ends_with(
-            "prssm_rmse_cfx,prssm_rmse_cfy,lrqsm_rmse_cfx,lrqsm_rmse_cfy,\
-             prssm_overall_rmse_std,lrqsm_overall_rmse_std"
+            "prssm_rmse_cfx,prssm_rmse_cfy,lrqsm_rmse_cfx,lrqsm_rmse_cfy,arx_rmse_cfx,arx_rmse_cfy,\
+             prssm_overall_rmse_std,lrqsm_overall_rmse_std,arx_overall_rmse_std"
         ));
         std::fs::remove_dir_all(&dir).ok();
 
         // One model without latent states: no authority analysis, no Fig. 5, no ratio.
-        let arx = lq;
         let dir = std::env::temp_dir().join(format!("flapssm-one-model-{}", std::process::id()));
         let r = evaluate(
             &ds,

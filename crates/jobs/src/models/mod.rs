@@ -8,6 +8,7 @@
 //! |---|---|---|
 //! | PR-SSM | [`prssm`] | particle ELBO with Adam ([`crate::train`]) |
 //! | LRQSM | [`lrqsm`] | elastic net with cross-validation (`flapssm-qs`) |
+//! | ARX | [`arx`] | least squares on lagged inputs |
 
 use flapssm_data::{Dataset, Trajectory};
 use flapssm_prssm::train::EpochRecord;
@@ -15,6 +16,7 @@ use flapssm_prssm::train::EpochRecord;
 use crate::error::{JobError, Result};
 use crate::progress::Progress;
 
+pub mod arx;
 pub mod lrqsm;
 pub mod prssm;
 
