@@ -14,7 +14,9 @@
 //! | [`plots`] | PNG/SVG figures (Figs. 2C, 3, 4, 5, training curves) | — |
 //! | [`report`] | one self-contained HTML page | — |
 //!
-//! Features: `parallel` (default) runs the per-trajectory cross-correlations on rayon.
+//! Features (both default): `parallel` runs the per-trajectory cross-correlations on rayon;
+//! `plots` builds [`plots`] (plotters, an embedded font, PNG encoding). Without it the crate is
+//! the analyses and the HTML report alone.
 #![warn(missing_docs)]
 
 pub mod authority;
@@ -22,6 +24,7 @@ pub mod cycles_avg;
 pub mod error;
 pub mod kde;
 pub mod metrics;
+#[cfg(feature = "plots")]
 pub mod plots;
 pub mod report;
 pub mod stats;

@@ -5,6 +5,15 @@
 //! numbers below, so that two jobs given the same master seed draw the same numbers for the same
 //! purpose: `flapssm predict`, `flapssm evaluate` and the demo predict trajectory `i` with
 //! identical particle draws.
+//!
+//! | stream | what |
+//! |---|---|
+//! | 7 ([`PREDICTION_STREAM`]) | open-loop prediction of trajectory `i` of a dataset |
+//! | 40 ([`SYSID_PREDICTION_STREAM`]) | sysid test-part prediction |
+//! | 41 ([`SYSID_RESTART_STREAM`]) | sysid restart training seeds |
+//!
+//! The engine derives its own streams from the training seed (minibatch order, particle draws
+//! per step, initialization): `flapssm_prssm::train` documents them.
 
 pub use flapssm_prssm::train::derive_seed;
 
@@ -16,3 +25,10 @@ pub const PREDICTION_STREAM: u64 = 7;
 pub fn prediction_seed(seed: u64, index: usize) -> u64 {
     derive_seed(seed, PREDICTION_STREAM, index as u64)
 }
+
+/// Stream of the sysid protocol's test-time particle draws (one index per seed and restart).
+pub const SYSID_PREDICTION_STREAM: u64 = 40;
+
+/// Stream of the training seeds of the sysid protocol's restarts `r ≥ 1` (restart 0 trains with
+/// the seed itself).
+pub const SYSID_RESTART_STREAM: u64 = 41;

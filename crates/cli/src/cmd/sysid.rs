@@ -6,7 +6,9 @@ use std::path::PathBuf;
 use anyhow::Context;
 use clap::Args;
 use flapssm_data::table::Column;
-use flapssm_jobs::sysid::{Combine, IoRecord, SeedRun, SysidSpec, run as run_protocol};
+use flapssm_jobs::sysid::{
+    Combine, IoRecord, SeedRun, SysidSpec, plot_test_prediction, run as run_protocol,
+};
 use flapssm_prssm::train::LrSchedule;
 
 /// Fit a PR-SSM on the first part of a record, simulate the rest open loop, report test
@@ -135,23 +137,13 @@ pub fn run(args: SysidArgs) -> anyhow::Result<()> {
     })
     .with_context(|| format!("sysid protocol on {}", args.file.display()))?;
     if let Some(path) = &args.plot {
-        let title = format!(
-            "{} — seed 0, test RMSE {:.4}",
-            args.file
-                .file_name()
-                .map(|s| s.to_string_lossy().into_owned())
-                .unwrap_or_default(),
-            report.runs[0].test.rmse
-        );
-        flapssm_analysis::plots::sysid::plot_test_prediction(
-            path,
-            &title,
-            &report.outputs,
-            &trace.outputs,
-            &trace.prediction.output_mean,
-            &trace.prediction.output_var,
-        )
-        .with_context(|| format!("writing figure {}", path.display()))?;
+        let label = args
+            .file
+            .file_name()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        plot_test_prediction(path, &label, &report, &trace)
+            .with_context(|| format!("writing figure {}", path.display()))?;
     }
     if json {
         println!("{}", serde_json::to_string_pretty(&report)?);

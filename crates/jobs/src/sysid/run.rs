@@ -1,332 +1,22 @@
-//! The system-identification protocol of Doerr et al. (2018) on one recorded input/output
-//! table: fit a PR-SSM on the first part, simulate the rest open loop, score it.
-//!
-//! Protocol ([`SysidSpec::reference`], `docs/sysid.md`):
-//!
-//! 1. Split the `T` samples at `n_train = ⌊split · T⌋`: train `0..n_train`, test `n_train..T`.
-//! 2. Fit the `sysid` preset of [`FitSpec`] (z-scoring with training statistics, ddof 0;
-//!    windows of 50 at stride 1, batch 10, `D_x = 4`, `M = 20`, SE-ARD, 50 particles,
-//!    Adam lr 0.1, 3000 iterations, recognition of `x₀` from the first 16 steps) `R` times
-//!    per seed ([`SysidSpec::restarts`], in parallel; `R = 1` in the reference protocol).
-//! 3. Predict the whole test part open loop, the initial state recognized from its first 16
-//!    steps of `(u, y)`, combine the restarts ([`Combine`]; [`mixture`]) and score every
-//!    test step:
-//!
-//! ```text
-//! RMSE_raw = sqrt( 1/(T_test·D_y) Σ_t Σ_j (y_tj − m_tj)² )                     (raw units)
-//! NLL      = 1/(T_test·D_y) Σ_t Σ_j [ ½ ln(2π v_tj) + (y_tj − m_tj)² / (2 v_tj) ]
-//! ```
-//!
-//! with the predictive mean `m` and variance `v` (particle variance + `σ_y²`); the NLL is in
-//! standardized units (`y`, `m`, `v` divided by the training std, so it is comparable across
-//! data sets), per sample and output.
+//! The protocol's run: restarts per seed fitted in parallel, the test part predicted open loop,
+//! the restarts combined and scored.
 
-use std::path::Path;
 use std::time::Instant;
 
-use flapssm_data::table::{Column, Table, TableError};
-use flapssm_prssm::Sequence;
 use flapssm_prssm::predict::Prediction;
-use flapssm_prssm::train::batches::derive_seed;
-use flapssm_prssm::train::fit::{FitError, FitSpec, Preset, fit, predict_raw};
-use flapssm_prssm::train::{Budget, TrainHooks};
+use flapssm_prssm::train::TrainHooks;
+use flapssm_prssm::train::fit::{FitError, fit, predict_raw};
 use serde::{Deserialize, Serialize};
 
-/// Seed stream of test-time particle draws.
-const PREDICT_STREAM: u64 = 40;
-
-/// Seed stream of the training seeds of restarts `r ≥ 1`.
-const RESTART_STREAM: u64 = 41;
+use super::score::{MeanStd, Scores, mixture, score};
+use super::{Combine, IoRecord, SysidError, SysidSpec, split_counts};
+use crate::seed::{SYSID_PREDICTION_STREAM, SYSID_RESTART_STREAM, derive_seed};
 
 /// One fitted restart: its record and test-part predictions (raw units).
 struct Restart {
     run: RestartRun,
     best: Prediction,
     last: Option<Prediction>,
-}
-
-/// Fewest training samples the protocol accepts.
-pub const MIN_TRAIN_SAMPLES: usize = 100;
-
-/// Why the protocol could not run.
-#[derive(Debug, thiserror::Error)]
-#[non_exhaustive]
-pub enum SysidError {
-    /// The table could not be read or a column does not exist.
-    #[error(transparent)]
-    Table(#[from] TableError),
-    /// A setting is out of range.
-    #[error("{field} = {value}: {why}")]
-    Setting {
-        /// Option name.
-        field: &'static str,
-        /// Value, formatted.
-        value: String,
-        /// Requirement.
-        why: String,
-    },
-    /// The split leaves too few samples on one side.
-    #[error(
-        "split {split} of {n_samples} samples leaves {n_train} training and {n_test} test samples; need at least {min_train} training and {min_test} test samples"
-    )]
-    Split {
-        /// The split fraction.
-        split: f64,
-        /// Samples in the table.
-        n_samples: usize,
-        /// Training samples.
-        n_train: usize,
-        /// Test samples.
-        n_test: usize,
-        /// Minimum of training samples.
-        min_train: usize,
-        /// Minimum of test samples.
-        min_test: usize,
-    },
-    /// Fitting or predicting failed.
-    #[error("run with seed {seed} failed")]
-    Fit {
-        /// Seed of the failed run.
-        seed: u64,
-        /// Cause.
-        source: FitError,
-    },
-}
-
-/// Input/output columns of a recorded table, row-major.
-#[derive(Debug, Clone, PartialEq)]
-pub struct IoRecord {
-    /// Input column names.
-    pub input_names: Vec<String>,
-    /// Output column names.
-    pub output_names: Vec<String>,
-    /// Inputs `u`, row-major `T × D_u`.
-    pub inputs: Vec<f64>,
-    /// Outputs `y`, row-major `T × D_y`.
-    pub outputs: Vec<f64>,
-}
-
-impl IoRecord {
-    /// Samples `T`.
-    pub fn n_samples(&self) -> usize {
-        self.outputs.len() / self.output_names.len().max(1)
-    }
-
-    /// Reads `path` ([`Table::read`] by extension; for `.mat`, only the named variables when
-    /// every column is given by name) and selects the input and output columns.
-    ///
-    /// # Errors
-    /// [`SysidError::Table`] for unreadable files and unknown columns (listing the available
-    /// ones), [`SysidError::Setting`] when no input or output is selected.
-    pub fn read(path: &Path, inputs: &[Column], outputs: &[Column]) -> Result<Self, SysidError> {
-        if inputs.is_empty() || outputs.is_empty() {
-            return Err(SysidError::Setting {
-                field: if inputs.is_empty() { "input" } else { "output" },
-                value: "none".into(),
-                why: "select at least one column".into(),
-            });
-        }
-        let is_mat = path
-            .extension()
-            .and_then(|e| e.to_str())
-            .is_some_and(|e| e.eq_ignore_ascii_case("mat"));
-        let names: Option<Vec<&str>> = inputs
-            .iter()
-            .chain(outputs)
-            .map(|c| match c {
-                Column::Name(n) => Some(n.as_str()),
-                Column::Index(_) => None,
-            })
-            .collect();
-        let table = match (is_mat, names) {
-            (true, Some(n)) => {
-                let mut uniq: Vec<&str> = Vec::new();
-                for v in n {
-                    if !uniq.contains(&v) {
-                        uniq.push(v);
-                    }
-                }
-                Table::read_mat(path, &uniq)?
-            }
-            _ => Table::read(path)?,
-        };
-        Ok(Self::from_table(&table, inputs, outputs)?)
-    }
-
-    /// Selects the input and output columns of `table`.
-    ///
-    /// # Errors
-    /// [`TableError::UnknownColumn`].
-    pub fn from_table(
-        table: &Table,
-        inputs: &[Column],
-        outputs: &[Column],
-    ) -> Result<Self, TableError> {
-        let u = table.select(inputs)?;
-        let y = table.select(outputs)?;
-        let interleave = |t: &Table| -> Vec<f64> {
-            (0..t.n_rows())
-                .flat_map(|i| t.columns.iter().map(move |c| c[i]))
-                .collect()
-        };
-        Ok(Self {
-            inputs: interleave(&u),
-            outputs: interleave(&y),
-            input_names: u.names,
-            output_names: y.names,
-        })
-    }
-
-    /// The first `n` samples (all when `n ≥ T`), e.g. the training part for a validation split.
-    pub fn head(&self, n: usize) -> IoRecord {
-        let n = n.min(self.n_samples());
-        let (du, dy) = (self.input_names.len(), self.output_names.len());
-        IoRecord {
-            input_names: self.input_names.clone(),
-            output_names: self.output_names.clone(),
-            inputs: self.inputs[..n * du].to_vec(),
-            outputs: self.outputs[..n * dy].to_vec(),
-        }
-    }
-
-    /// The samples `range` as a raw PR-SSM sequence.
-    fn sequence(&self, range: std::ops::Range<usize>) -> Sequence {
-        let (du, dy) = (self.input_names.len(), self.output_names.len());
-        Sequence {
-            inputs: self.inputs[range.start * du..range.end * du].to_vec(),
-            outputs: self.outputs[range.start * dy..range.end * dy].to_vec(),
-        }
-    }
-}
-
-/// How the restarts of one seed are turned into one prediction.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Combine {
-    /// Equal-weight mixture of the `R` restarts' predictive distributions, moment-matched:
-    /// `m = (1/R) Σ_r m_r`, `v = (1/R) Σ_r (v_r + m_r²) − m²`. Its RMSE is never above the
-    /// mean RMSE of the restarts (convexity of the squared error).
-    Ensemble,
-    /// The restart with the lowest open-loop RMSE on the training part (standardized units;
-    /// `x₀` recognized from its first steps, as at test time).
-    Select,
-    /// Like [`Combine::Ensemble`] over `2R` members: the selected (best) and the last
-    /// parameters of every restart (a snapshot ensemble).
-    Snapshots,
-}
-
-/// Settings of the protocol.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct SysidSpec {
-    /// Fraction of the samples (the first ones) used for training, in (0, 1).
-    pub split: f64,
-    /// Seeds `0..seeds` (one fit each; the seed replaces `fit.train.seed`).
-    pub seeds: u64,
-    /// Independent fits per seed (≥ 1), run in parallel. Restart 0 uses the seed itself,
-    /// restart `r ≥ 1` the training seed `derive_seed(seed, 41, r)`.
-    #[serde(default = "one_restart")]
-    pub restarts: usize,
-    /// How the restarts are combined (irrelevant for one restart).
-    #[serde(default = "ensemble")]
-    pub combine: Combine,
-    /// Particles of the test-time prediction (per restart).
-    pub predict_particles: usize,
-    /// The fit (model sizes must match the record's `D_u`, `D_y`).
-    pub fit: FitSpec,
-}
-
-fn one_restart() -> usize {
-    1
-}
-
-fn ensemble() -> Combine {
-    Combine::Ensemble
-}
-
-impl SysidSpec {
-    /// The reference protocol for `n_input` inputs and `n_output` outputs: split 0.5, 3 seeds,
-    /// the `sysid` preset (3000 iterations), 50 prediction particles.
-    pub fn reference(n_input: usize, n_output: usize) -> Self {
-        Self {
-            split: 0.5,
-            seeds: 3,
-            restarts: 1,
-            combine: Combine::Ensemble,
-            predict_particles: 50,
-            fit: FitSpec::preset(Preset::Sysid, n_input, n_output),
-        }
-    }
-
-    /// Sets the optimizer steps per fit.
-    pub fn with_iterations(mut self, iterations: u64) -> Self {
-        self.fit.train.budget = Budget::Iterations(iterations);
-        self
-    }
-
-    fn check(&self, n_input: usize, n_output: usize) -> Result<(), SysidError> {
-        let bad = |field, value: String, why: &str| {
-            Err(SysidError::Setting {
-                field,
-                value,
-                why: why.into(),
-            })
-        };
-        if !(self.split > 0.0 && self.split < 1.0) {
-            return bad("split", self.split.to_string(), "must be in (0, 1)");
-        }
-        if self.seeds == 0 {
-            return bad("seeds", "0".into(), "must be ≥ 1");
-        }
-        if matches!(
-            self.fit.train.budget,
-            Budget::Iterations(0) | Budget::Epochs(0)
-        ) {
-            return bad("iterations", "0".into(), "must be ≥ 1");
-        }
-        if self.restarts == 0 {
-            return bad("restarts", "0".into(), "must be ≥ 1");
-        }
-        if self.predict_particles == 0 {
-            return bad("predict_particles", "0".into(), "must be ≥ 1");
-        }
-        let m = &self.fit.model;
-        if (m.n_input, m.n_output) != (n_input, n_output) {
-            return bad(
-                "fit.model (n_input, n_output)",
-                format!("({}, {})", m.n_input, m.n_output),
-                &format!("the record has {n_input} inputs and {n_output} outputs"),
-            );
-        }
-        Ok(())
-    }
-}
-
-/// Test scores of one prediction.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct Scores {
-    /// RMSE over every test step and output, raw units.
-    pub rmse: f64,
-    /// Gaussian NLL per sample and output, standardized units (module docs).
-    pub nll: f64,
-}
-
-/// Scores `pred` (raw units) against raw outputs `y` (`T × D_y`) with training stds `std`.
-pub fn score(y: &[f64], mean: &[f64], var: &[f64], std: &[f64]) -> Scores {
-    let dy = std.len().max(1);
-    let (mut s2, mut nll) = (0.0, 0.0);
-    for (i, ((y, m), v)) in y.iter().zip(mean).zip(var).enumerate() {
-        let e = y - m;
-        s2 += e * e;
-        let s = std[i % dy];
-        let vz = v / (s * s);
-        let ez = e / s;
-        nll += 0.5 * (2.0 * std::f64::consts::PI * vz).ln() + ez * ez / (2.0 * vz);
-    }
-    let n = y.len().max(1) as f64;
-    Scores {
-        rmse: (s2 / n).sqrt(),
-        nll: nll / n,
-    }
 }
 
 /// One restart (independent fit) of a seed.
@@ -368,65 +58,6 @@ pub struct SeedRun {
     pub last_test: Option<Scores>,
 }
 
-/// Equal-weight moment-matched mixture of predictions of the same outputs:
-/// `m = (1/R) Σ m_r`, `v = (1/R) Σ (v_r + m_r²) − m²` (outputs only; the latent moments are
-/// left empty because latent coordinates of different fits are not comparable). `None` when
-/// `preds` is empty or the output lengths differ.
-pub fn mixture(preds: &[Prediction]) -> Option<Prediction> {
-    let first = preds.first()?;
-    let n = first.output_mean.len();
-    if preds
-        .iter()
-        .any(|p| p.output_mean.len() != n || p.output_var.len() != n)
-    {
-        return None;
-    }
-    let r = preds.len() as f64;
-    let mut mean = vec![0.0; n];
-    let mut second = vec![0.0; n];
-    for p in preds {
-        for i in 0..n {
-            let m = p.output_mean[i];
-            mean[i] += m / r;
-            second[i] += (p.output_var[i] + m * m) / r;
-        }
-    }
-    let var = second
-        .iter()
-        .zip(&mean)
-        .map(|(s, m)| (s - m * m).max(0.0))
-        .collect();
-    Some(Prediction {
-        output_mean: mean,
-        output_var: var,
-        latent_mean: Vec::new(),
-        latent_var: Vec::new(),
-    })
-}
-
-/// Mean and standard deviation (ddof 0) over seeds.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct MeanStd {
-    /// Mean.
-    pub mean: f64,
-    /// Standard deviation (ddof 0).
-    pub std: f64,
-}
-
-impl MeanStd {
-    /// Of `values` (NaN when empty).
-    pub fn of(values: impl IntoIterator<Item = f64>) -> Self {
-        let v: Vec<f64> = values.into_iter().collect();
-        let n = v.len() as f64;
-        let mean = v.iter().sum::<f64>() / n;
-        let var = v.iter().map(|x| (x - mean) * (x - mean)).sum::<f64>() / n;
-        Self {
-            mean,
-            std: var.sqrt(),
-        }
-    }
-}
-
 /// The protocol's result.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SysidReport {
@@ -459,27 +90,6 @@ pub struct TestTrace {
     pub outputs: Vec<f64>,
     /// Prediction of the first seed (raw output moments).
     pub prediction: Prediction,
-}
-
-/// Training/test sample counts for `n` samples, checked.
-///
-/// # Errors
-/// [`SysidError::Split`] when fewer than [`MIN_TRAIN_SAMPLES`] training samples or fewer test
-/// samples than the recognition window remain.
-pub fn split_counts(split: f64, n: usize, min_test: usize) -> Result<(usize, usize), SysidError> {
-    let n_train = ((split * n as f64).floor() as usize).min(n);
-    let n_test = n - n_train;
-    if n_train < MIN_TRAIN_SAMPLES || n_test < min_test {
-        return Err(SysidError::Split {
-            split,
-            n_samples: n,
-            n_train,
-            n_test,
-            min_train: MIN_TRAIN_SAMPLES,
-            min_test,
-        });
-    }
-    Ok((n_train, n_test))
 }
 
 /// Runs the protocol on `record`, one fit per seed (sequentially; each fit is parallel
@@ -548,7 +158,7 @@ pub fn run(
             let mut fs = spec.fit.clone();
             fs.train.seed = match r {
                 0 => seed,
-                _ => derive_seed(seed, RESTART_STREAM, r as u64),
+                _ => derive_seed(seed, SYSID_RESTART_STREAM, r as u64),
             };
             let out = fit(
                 &fs,
@@ -557,7 +167,7 @@ pub fn run(
                 TrainHooks::default(),
                 None,
             )?;
-            let predict_seed = derive_seed(seed, PREDICT_STREAM, r as u64);
+            let predict_seed = derive_seed(seed, SYSID_PREDICTION_STREAM, r as u64);
             let best = predict_raw(&out.best, &test, spec.predict_particles, predict_seed)?;
             let last = match diagnose_last || spec.combine == Combine::Snapshots {
                 true => Some(predict_raw(
@@ -696,6 +306,7 @@ pub fn run(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use flapssm_data::table::{Column, Table};
 
     #[test]
     fn scores_match_hand_computed_values() {
