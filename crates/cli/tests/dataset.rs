@@ -7,8 +7,8 @@ use std::path::{Path, PathBuf};
 use common::{assert_fails, flapssm, s};
 use std::process::Output;
 
-use flapssm_data::Dataset;
 use flapssm_data::npz::{NpyData, NpzReader, NpzWriter};
+use flapssm_wing::dataset::Dataset;
 
 fn fixture(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))

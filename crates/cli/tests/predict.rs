@@ -7,8 +7,8 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use common::{assert_fails, flapssm, ok, reference, s, simulated};
-use flapssm_data::Dataset;
 use flapssm_data::npz::NpzReader;
+use flapssm_wing::dataset::Dataset;
 
 const T: usize = 470;
 

@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use common::flapssm;
 
 use flapssm_data::npz::NpzReader;
-use flapssm_data::{Dataset, DatasetMeta, Trajectory};
+use flapssm_wing::dataset::{Dataset, DatasetMeta, Trajectory};
 use flapssm_wing::features::published_features;
 
 fn reference() -> PathBuf {

@@ -3,7 +3,7 @@
 mod common;
 
 use common::{assert_fails, flapssm, ok, s};
-use flapssm_data::Dataset;
+use flapssm_wing::dataset::Dataset;
 
 fn generate(dir: &std::path::Path, name: &str, extra: &[&str]) -> std::path::PathBuf {
     let out = dir.join(name);

@@ -6,7 +6,6 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::csv::split_csv_line;
 use crate::mat::{MatError, MatFile};
 
 /// Errors reading or selecting table columns.
@@ -347,6 +346,37 @@ fn finish(path: &Path, names: Vec<String>, columns: Vec<Vec<f64>>) -> Result<Tab
         names,
         columns,
     })
+}
+
+/// Splits one CSV line into fields; `"…"` quoting with `""` escapes is understood.
+///
+/// # Errors
+/// A message for an unterminated quote.
+pub fn split_csv_line(line: &str) -> Result<Vec<String>, String> {
+    let mut out = Vec::new();
+    let mut field = String::new();
+    let mut chars = line.trim_end_matches('\r').chars().peekable();
+    let mut quoted = false;
+    while let Some(c) = chars.next() {
+        match (quoted, c) {
+            (false, ',') => out.push(std::mem::take(&mut field)),
+            (false, '"') if field.trim().is_empty() => {
+                field.clear();
+                quoted = true;
+            }
+            (true, '"') if chars.peek() == Some(&'"') => {
+                chars.next();
+                field.push('"');
+            }
+            (true, '"') => quoted = false,
+            (_, c) => field.push(c),
+        }
+    }
+    if quoted {
+        return Err("unterminated quoted field".into());
+    }
+    out.push(field);
+    Ok(out)
 }
 
 #[cfg(test)]

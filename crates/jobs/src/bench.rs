@@ -22,7 +22,7 @@ pub const TRAIN_SEQUENCES: usize = 512;
 /// Minibatches per epoch of the paper's configuration (512 / 16).
 pub const BATCHES_PER_EPOCH: usize = 32;
 
-/// Settings of [`bench`].
+/// Settings of [`bench()`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BenchSettings {
     /// Minibatches timed (1..=32); the epoch is extrapolated from them.
@@ -43,7 +43,7 @@ impl Default for BenchSettings {
     }
 }
 
-/// What [`bench`] measured.
+/// What [`bench()`] measured.
 #[derive(Debug, Clone, PartialEq)]
 pub struct BenchReport {
     /// Threads of the pool the training ran on.

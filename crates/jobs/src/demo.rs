@@ -21,10 +21,10 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
-use flapssm_data::{Dataset, OUTPUT_NAMES};
 use flapssm_prssm::PrssmModel;
 use flapssm_prssm::train::{Checkpoint, LrSchedule};
 use flapssm_qs::{EnetOptions, LrqsmModel};
+use flapssm_wing::dataset::{Dataset, OUTPUT_NAMES};
 use flapssm_wing::features::FeatureSet;
 use flapssm_wing::virtual_wing::{Fidelity, SimulationConfig, simulate_dataset};
 use serde::{Deserialize, Serialize};

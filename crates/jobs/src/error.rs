@@ -13,14 +13,14 @@ use flapssm_wing::cycles::CycleError;
 pub enum JobError {
     /// The dataset is invalid or unsuitable.
     #[error("dataset: {0}")]
-    Dataset(#[from] flapssm_data::DatasetError),
+    Dataset(#[from] flapssm_wing::dataset::DatasetError),
     /// A dataset file could not be read or written.
     #[error("dataset file {path}: {source}")]
     DatasetFile {
         /// The file.
         path: PathBuf,
         /// Cause.
-        source: flapssm_data::StoreError,
+        source: flapssm_wing::dataset::StoreError,
     },
     /// A PR-SSM model file could not be read or written.
     #[error("PR-SSM model file {path}: {source}")]

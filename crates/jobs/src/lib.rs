@@ -11,7 +11,7 @@
 //! | [`evaluate`] | both models on a dataset: metrics, authority, figures, report |
 //! | [`sweep`] | one-configuration PR-SSM sweep runs (D_x, training-set size) and their merge |
 //! | [`demo`] | the one-command demo: simulate, fit, train, evaluate (resumable) |
-//! | [`bench`] | the engine's speed in the paper's configuration beside the authors' code |
+//! | [`bench`](mod@bench) | the engine's speed in the paper's configuration beside the authors' code |
 //! | [`sysid`] | Doerr et al. system-identification protocol (fit, open-loop test, RMSE/NLL) |
 //!
 //! Shared pieces: [`error`] (one error type naming the file, trajectory or stage), [`progress`]
@@ -32,6 +32,8 @@ pub mod progress;
 pub mod seed;
 pub mod sweep;
 pub mod sysid;
+#[cfg(test)]
+mod test_data;
 pub mod threads;
 pub mod train;
 

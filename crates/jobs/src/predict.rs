@@ -7,14 +7,15 @@
 use std::path::Path;
 
 use flapssm_data::npz::{NpyData, NpzWriter};
-use flapssm_data::{Dataset, Trajectory};
 use flapssm_prssm::predict::Prediction;
 use flapssm_prssm::train::InitialStateSpec;
 use flapssm_prssm::train::fit::training_record;
 use flapssm_prssm::{PrssmModel, Sequence};
 use flapssm_qs::{InterceptMode, LrqsmModel};
+use flapssm_wing::dataset::{Dataset, Trajectory};
 
 use crate::error::{JobError, Result};
+use crate::models::map_trajectories;
 use crate::models::prssm::PrssmLoadModel;
 use crate::progress::Progress;
 use crate::seed::prediction_seed;
@@ -76,20 +77,11 @@ pub fn predict_prssm(
     progress: &dyn Progress,
 ) -> Result<Vec<PrssmPrediction>> {
     let model = PrssmLoadModel::new(model, ds, particles, seed)?;
-    let one = |(i, t): (usize, &Trajectory)| -> Result<PrssmPrediction> {
+    map_trajectories(ds, |i, t| {
         let p = model.predict(i, t)?;
         progress.advance(1);
         Ok(p)
-    };
-    #[cfg(feature = "parallel")]
-    {
-        use rayon::prelude::*;
-        ds.trajectories.par_iter().enumerate().map(one).collect()
-    }
-    #[cfg(not(feature = "parallel"))]
-    {
-        ds.trajectories.iter().enumerate().map(one).collect()
-    }
+    })
 }
 
 /// LRQSM predictions (N, N·mm) of every trajectory, one `n × 5` table each.
@@ -240,15 +232,7 @@ pub fn predict_inputs(
 mod tests {
     use super::*;
     use crate::progress::NoProgress;
-    use flapssm_wing::virtual_wing::{SimulationConfig, simulate_dataset};
-
-    fn tiny_dataset() -> Dataset {
-        let mut cfg = SimulationConfig::default();
-        cfg.trajectories.n_trajectories = 6;
-        cfg.trajectories.n_train = 4;
-        cfg.trajectories.seed = 3;
-        simulate_dataset(&cfg, &|| {}).unwrap()
-    }
+    use crate::test_data::{bare_model, tiny_dataset};
 
     #[test]
     /// Regression: a model without normalization statistics (the published one works in
@@ -256,14 +240,7 @@ mod tests {
     /// model carrying the dataset's training statistics.
     fn a_model_without_statistics_uses_the_dataset_training_statistics() {
         let ds = tiny_dataset();
-        let cfg = flapssm_prssm::ModelConfig::new(6, 5, 7, 4);
-        let params = flapssm_prssm::Params::init(&cfg, &Default::default(), 3);
-        let bare = PrssmModel {
-            config: cfg,
-            params,
-            normalization: None,
-            training: serde_json::Value::Null,
-        };
+        let bare = bare_model(flapssm_prssm::ModelConfig::new(6, 5, 7, 4), 3);
         let s = ds.standardization().unwrap();
         let mut with_stats = bare.clone();
         with_stats.normalization = Some(flapssm_prssm::Normalization {
@@ -294,14 +271,7 @@ mod tests {
     #[test]
     fn model_of_the_wrong_shape_is_rejected() {
         let ds = tiny_dataset();
-        let cfg = flapssm_prssm::ModelConfig::new(4, 2, 3, 5);
-        let params = flapssm_prssm::Params::init(&cfg, &Default::default(), 1);
-        let m = PrssmModel {
-            config: cfg,
-            params,
-            normalization: None,
-            training: serde_json::Value::Null,
-        };
+        let m = bare_model(flapssm_prssm::ModelConfig::new(4, 2, 3, 5), 1);
         let e = predict_prssm(&m, &ds, 2, 0, &NoProgress).unwrap_err();
         assert!(e.to_string().contains("7 inputs and 5 outputs"), "{e}");
     }

@@ -11,9 +11,9 @@ use std::path::Path;
 use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
-use flapssm_data::{Dataset, OUTPUT_NAMES};
 use flapssm_prssm::train::EpochRecord;
 use flapssm_prssm::train::fit::FitSpec;
+use flapssm_wing::dataset::{Dataset, OUTPUT_NAMES};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{JobError, Result};

@@ -4,10 +4,10 @@
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 
-use flapssm_data::{Dataset, Trajectory};
 use flapssm_prssm::Sequence;
 use flapssm_prssm::train::fit::{FitOutcome, FitSpec, Preset, fit};
 use flapssm_prssm::train::{Budget, Checkpoint, LrSchedule, TrainEvent, TrainHooks};
+use flapssm_wing::dataset::{Dataset, Trajectory};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{JobError, Result};
@@ -200,7 +200,7 @@ impl TrainingPlan {
         train: &'a [Trajectory],
     ) -> Result<(&'a [Trajectory], &'a [Trajectory])> {
         if train.is_empty() {
-            return Err(flapssm_data::DatasetError::NoTrainingData { n_train: 0 }.into());
+            return Err(flapssm_wing::dataset::DatasetError::NoTrainingData { n_train: 0 }.into());
         }
         let n_val =
             ((train.len() as f64 * self.val_fraction).round() as usize).min(train.len() - 1);
@@ -375,7 +375,7 @@ pub fn train_dataset(
     stop: Option<&AtomicBool>,
 ) -> Result<TrainSummary> {
     if !ds.has_outputs() {
-        return Err(flapssm_data::DatasetError::NoOutputs.into());
+        return Err(flapssm_wing::dataset::DatasetError::NoOutputs.into());
     }
     let (n_fit, n_val) = plan.split(ds.train()).map(|(a, b)| (a.len(), b.len()))?;
     let description = plan.describe_split(n_fit, n_val);
@@ -419,15 +419,7 @@ pub fn train_dataset(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use flapssm_wing::virtual_wing::{SimulationConfig, simulate_dataset};
-
-    fn tiny_dataset() -> Dataset {
-        let mut cfg = SimulationConfig::default();
-        cfg.trajectories.n_trajectories = 6;
-        cfg.trajectories.n_train = 4;
-        cfg.trajectories.seed = 3;
-        simulate_dataset(&cfg, &|| {}).unwrap()
-    }
+    use crate::test_data::tiny_dataset;
 
     #[test]
     fn validation_split_follows_the_fraction() {

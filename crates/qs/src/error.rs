@@ -121,7 +121,7 @@ pub enum QsError {
     },
     /// The dataset is invalid or lacks what the fit needs (outputs, training data).
     #[error(transparent)]
-    Dataset(#[from] flapssm_data::dataset::DatasetError),
+    Dataset(#[from] flapssm_wing::dataset::DatasetError),
     /// The data do not fit the model (wrong features, no outputs, …).
     #[error("{0}")]
     Mismatch(String),

@@ -8,7 +8,7 @@
 use std::path::Path;
 
 use flapssm_data::npz::{NpyData, NpzWriter};
-use flapssm_data::{Dataset, OUTPUT_NAMES, Trajectory};
+use flapssm_wing::dataset::{Dataset, OUTPUT_NAMES, Trajectory};
 use flapssm_wing::features::FeatureSet;
 
 use crate::cv::{Columns, EnetOptions, fit_enet_cv};

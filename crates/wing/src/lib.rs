@@ -8,6 +8,7 @@
 pub mod aero;
 mod check;
 pub mod cycles;
+pub mod dataset;
 pub mod differentiate;
 pub mod features;
 pub mod kinematics;

@@ -26,11 +26,9 @@
 //! (paper test trajectories #5 and #32).
 
 use crate::cycles::{self, CycleError, U_REF_RADIUS_M};
+use crate::dataset::{Dataset, Trajectory};
+use crate::dataset::{DatasetMeta, FORMAT_VERSION, Fluid, INPUT_UNITS, OUTPUT_UNITS, WingGeometry};
 use crate::kinematics::{EulerState, WingKinematics};
-use flapssm_data::dataset::{
-    DatasetMeta, FORMAT_VERSION, Fluid, INPUT_UNITS, OUTPUT_UNITS, WingGeometry,
-};
-use flapssm_data::{Dataset, Trajectory};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};

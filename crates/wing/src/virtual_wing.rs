@@ -16,14 +16,12 @@ use crate::aero::unsteady::UnsteadyParams;
 use crate::aero::{SectionGeometry, SectionModelFactory};
 use crate::check::first_not_positive;
 use crate::cycles::{self, CycleError};
+use crate::dataset::{Dataset, Trajectory};
+use crate::dataset::{DatasetMeta, FORMAT_VERSION, Fluid, INPUT_UNITS, OUTPUT_UNITS, WingGeometry};
 use crate::kinematics::{EulerState, WingKinematics, rotation_global_from_wing};
 use crate::sensor::{DatasetSensorErrors, SensorConfig, measure};
 use crate::trajectories::{GeneratorConfig, TrajectoryError, TrajectorySpec};
 use crate::vortex::{StripLdvmFactory, StripLdvmParams, VortexError};
-use flapssm_data::dataset::{
-    DatasetMeta, FORMAT_VERSION, Fluid, INPUT_UNITS, OUTPUT_UNITS, WingGeometry,
-};
-use flapssm_data::{Dataset, Trajectory};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};

@@ -18,8 +18,8 @@
 
 use faer::Mat;
 use faer::linalg::solvers::Solve;
-use flapssm_data::Dataset;
 use flapssm_wing::aero::quasi_steady::ChordwiseModel;
+use flapssm_wing::dataset::Dataset;
 use flapssm_wing::features::published_features;
 use flapssm_wing::sensor::SensorConfig;
 use flapssm_wing::trajectories::GeneratorConfig;

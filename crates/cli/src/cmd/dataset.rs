@@ -4,9 +4,9 @@ use std::path::PathBuf;
 
 use anyhow::{Context, bail};
 use clap::{Args, Subcommand};
-use flapssm_data::Dataset;
-use flapssm_data::published::import_published_mat;
 use flapssm_wing::cycles::{U_REF_RADIUS_M, published_u_ref};
+use flapssm_wing::dataset::Dataset;
+use flapssm_wing::dataset::published::import_published_mat;
 
 /// Dataset files: inspect, export to CSV, import from MAT or CSV.
 #[derive(Args)]

@@ -4,7 +4,6 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 use clap::Args;
-use flapssm_data::Dataset;
 use flapssm_jobs::evaluate::{EvalOptions, ReportContext, evaluate};
 use flapssm_jobs::models::arx::ArxSettings;
 use flapssm_jobs::models::lrqsm::LrqsmLoadModel;
@@ -12,6 +11,7 @@ use flapssm_jobs::models::prssm::PrssmLoadModel;
 use flapssm_jobs::models::{Fit, LoadModel};
 use flapssm_prssm::PrssmModel;
 use flapssm_qs::LrqsmModel;
+use flapssm_wing::dataset::Dataset;
 
 use crate::progress::Bars;
 

@@ -5,10 +5,10 @@ use std::path::PathBuf;
 
 use anyhow::{Context, bail};
 use clap::Args;
-use flapssm_data::Dataset;
 use flapssm_data::table::Table;
 use flapssm_jobs::predict::{predict_dataset_file, predict_inputs};
 use flapssm_prssm::PrssmModel;
+use flapssm_wing::dataset::Dataset;
 
 use crate::progress::Bars;
 

@@ -4,11 +4,11 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use clap::{Args, Subcommand, ValueEnum};
-use flapssm_data::Dataset;
 use flapssm_qs::cv::{EnetOptions, FoldLayout, LambdaRule};
 use flapssm_qs::lrqsm::{Rmse, fit_dataset, predict_dataset};
 use flapssm_qs::table::{fit_table, read_csv};
 use flapssm_qs::{InterceptMode, LrqsmModel};
+use flapssm_wing::dataset::Dataset;
 use flapssm_wing::features::FeatureSet;
 
 /// Quasi-steady baseline subcommands.

@@ -4,11 +4,11 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 use clap::{Args, Subcommand};
-use flapssm_data::Dataset;
 use flapssm_jobs::files::save_json;
 use flapssm_jobs::sweep::{SweepKind, SweepTable, load_result, sweep_run};
 use flapssm_jobs::train::TrainingOptions;
 use flapssm_prssm::train::fit::Preset;
+use flapssm_wing::dataset::Dataset;
 
 use crate::progress::{Bars, stop_flag};
 

@@ -4,10 +4,10 @@ use std::path::PathBuf;
 
 use anyhow::{Context, bail};
 use clap::Args;
-use flapssm_data::Dataset;
 use flapssm_jobs::train::{TrainFiles, TrainingOptions, train_dataset};
 use flapssm_prssm::train::LrSchedule;
 use flapssm_prssm::train::fit::Preset;
+use flapssm_wing::dataset::Dataset;
 
 use crate::progress::{Bars, stop_flag};
 

@@ -2,8 +2,8 @@
 
 use std::path::Path;
 
-use flapssm_data::Dataset;
 use flapssm_prssm::train::EpochRecord;
+use flapssm_wing::dataset::Dataset;
 
 use flapssm_analysis::plots::{timeseries as pt, training};
 

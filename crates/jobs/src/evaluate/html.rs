@@ -2,7 +2,7 @@
 
 use std::path::PathBuf;
 
-use flapssm_data::OUTPUT_NAMES;
+use flapssm_wing::dataset::OUTPUT_NAMES;
 
 use flapssm_analysis::report::{Figure, Report, Section, Table};
 use flapssm_analysis::stats::Interval;

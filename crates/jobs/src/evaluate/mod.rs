@@ -20,8 +20,8 @@
 
 use std::path::{Path, PathBuf};
 
-use flapssm_data::{Dataset, OUTPUT_NAMES};
 use flapssm_wing::cycles::published_window;
+use flapssm_wing::dataset::{Dataset, OUTPUT_NAMES};
 use serde::{Deserialize, Serialize};
 
 use flapssm_analysis::authority::{
@@ -343,11 +343,11 @@ pub fn evaluate(
 fn check(ds: &Dataset, models: &[&dyn LoadModel], opts: &EvalOptions) -> Result<()> {
     ds.validate()?;
     if !ds.has_outputs() {
-        return Err(flapssm_data::DatasetError::NoOutputs.into());
+        return Err(flapssm_wing::dataset::DatasetError::NoOutputs.into());
     }
     let n_train = ds.n_train.min(ds.len());
     if n_train == 0 {
-        return Err(flapssm_data::DatasetError::NoTrainingData { n_train }.into());
+        return Err(flapssm_wing::dataset::DatasetError::NoTrainingData { n_train }.into());
     }
     if models.is_empty() {
         return Err(JobError::Mismatch {
@@ -732,17 +732,9 @@ mod tests {
     use crate::models::lrqsm::LrqsmLoadModel;
     use crate::models::prssm::PrssmLoadModel;
     use crate::progress::NoProgress;
+    use crate::test_data::tiny_dataset;
     use crate::train::{TrainingOptions, train_prssm};
     use flapssm_qs::InterceptMode;
-    use flapssm_wing::virtual_wing::{SimulationConfig, simulate_dataset};
-
-    fn tiny_dataset() -> Dataset {
-        let mut cfg = SimulationConfig::default();
-        cfg.trajectories.n_trajectories = 6;
-        cfg.trajectories.n_train = 4;
-        cfg.trajectories.seed = 3;
-        simulate_dataset(&cfg, &|| {}).unwrap()
-    }
 
     /// The pipeline's LRQSM errors agree with the qs crate's own RMSE (computed there from raw
     /// loads divided by σ), and its sums are consistent: overall² = mean of per-output RMSE²,

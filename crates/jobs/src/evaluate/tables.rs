@@ -2,7 +2,7 @@
 
 use std::path::Path;
 
-use flapssm_data::Dataset;
+use flapssm_wing::dataset::Dataset;
 
 use flapssm_data::npz::{NpyData, NpzWriter};
 

@@ -15,7 +15,7 @@
 
 use faer::linalg::solvers::Solve;
 use faer::{Mat, Side};
-use flapssm_data::{Dataset, Trajectory};
+use flapssm_wing::dataset::{Dataset, Trajectory};
 use serde::{Deserialize, Serialize};
 
 use super::{Fit, LoadModel, LoadPrediction, check_buffer};
@@ -160,7 +160,7 @@ impl Fit for ArxFit {
             }
         }
         if n_rows == 0 {
-            return Err(flapssm_data::DatasetError::NoOutputs.into());
+            return Err(flapssm_wing::dataset::DatasetError::NoOutputs.into());
         }
         for a in 0..p {
             xtx[(a, a)] += self.settings.ridge * n_rows as f64;

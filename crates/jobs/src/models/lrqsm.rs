@@ -3,9 +3,9 @@
 
 use std::borrow::Cow;
 
-use flapssm_data::{Dataset, OUTPUT_NAMES, Trajectory};
 use flapssm_qs::lrqsm::{fit_dataset, trajectory_features};
 use flapssm_qs::{EnetOptions, InterceptMode, LrqsmModel};
+use flapssm_wing::dataset::{Dataset, OUTPUT_NAMES, Trajectory};
 use flapssm_wing::features::FeatureSet;
 
 use super::{Fit, LoadModel, LoadPrediction, check_buffer};

@@ -10,8 +10,8 @@
 //! | LRQSM | [`lrqsm`] | elastic net with cross-validation (`flapssm-qs`) |
 //! | ARX | [`arx`] | least squares on lagged inputs |
 
-use flapssm_data::{Dataset, Trajectory};
 use flapssm_prssm::train::EpochRecord;
+use flapssm_wing::dataset::{Dataset, Trajectory};
 
 use crate::error::{JobError, Result};
 use crate::progress::Progress;
@@ -98,7 +98,7 @@ pub fn predict_all(
     ds: &Dataset,
     progress: &dyn Progress,
 ) -> Result<Vec<ModelPrediction>> {
-    let one = |(i, t): (usize, &Trajectory)| -> Result<ModelPrediction> {
+    map_trajectories(ds, |i, t| {
         let n = t.inputs.len();
         let mut p = ModelPrediction {
             mean: vec![0.0; n * 5],
@@ -116,15 +116,34 @@ pub fn predict_all(
         )?;
         progress.advance(1);
         Ok(p)
-    };
+    })
+}
+
+/// `f(i, trajectory)` for every trajectory of `ds`, in parallel with feature `parallel` (on the
+/// caller's pool), results in trajectory order; the first error wins.
+///
+/// # Errors
+/// The first trajectory's error.
+pub fn map_trajectories<T: Send>(
+    ds: &Dataset,
+    f: impl Fn(usize, &Trajectory) -> Result<T> + Sync,
+) -> Result<Vec<T>> {
     #[cfg(feature = "parallel")]
     {
         use rayon::prelude::*;
-        ds.trajectories.par_iter().enumerate().map(one).collect()
+        ds.trajectories
+            .par_iter()
+            .enumerate()
+            .map(|(i, t)| f(i, t))
+            .collect()
     }
     #[cfg(not(feature = "parallel"))]
     {
-        ds.trajectories.iter().enumerate().map(one).collect()
+        ds.trajectories
+            .iter()
+            .enumerate()
+            .map(|(i, t)| f(i, t))
+            .collect()
     }
 }
 

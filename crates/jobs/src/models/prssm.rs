@@ -3,11 +3,11 @@
 
 use std::borrow::Cow;
 
-use flapssm_data::{Dataset, Trajectory};
 use flapssm_prssm::PrssmModel;
 use flapssm_prssm::predict::Prediction;
 use flapssm_prssm::train::EpochRecord;
 use flapssm_prssm::train::fit::{predict_raw, training_record};
+use flapssm_wing::dataset::{Dataset, Trajectory};
 
 use super::{Fit, LoadModel, LoadPrediction, check_buffer};
 use crate::error::{JobError, Result};

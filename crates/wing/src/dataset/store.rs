@@ -22,7 +22,7 @@ use std::path::{Path, PathBuf};
 use crate::dataset::{
     Dataset, DatasetError, DatasetMeta, FORMAT_VERSION, INPUT_NAMES, OUTPUT_NAMES, Trajectory,
 };
-use crate::npz::{NpyData, NpzError, NpzReader, NpzWriter};
+use flapssm_data::npz::{NpyData, NpzError, NpzReader, NpzWriter};
 
 /// Errors saving or loading a dataset file.
 #[derive(Debug, thiserror::Error)]
@@ -107,7 +107,7 @@ fn flatten<const N: usize>(rows: impl Iterator<Item = [f64; N]>, cap: usize) -> 
 
 impl Dataset {
     /// Validates the dataset and writes it atomically to `path` as one `.npz` (see
-    /// [`crate::store`] for the arrays). Statistics are those of the training part (ddof 0).
+    /// [`crate::dataset::store`] for the arrays). Statistics are those of the training part (ddof 0).
     ///
     /// # Errors
     /// [`StoreError::Invalid`] if [`Dataset::validate`] fails or the training part holds no
@@ -257,7 +257,7 @@ impl Loader {
     fn checked(
         &self,
         array: &'static str,
-        a: crate::npz::Array<f64>,
+        a: flapssm_data::npz::Array<f64>,
         shape: &[usize],
     ) -> Result<Vec<f64>, StoreError> {
         if a.shape != shape {
@@ -579,7 +579,8 @@ mod tests {
 
     #[test]
     fn loads_a_file_written_by_numpy() {
-        let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/tiny_dataset.npz");
+        let p =
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("../data/tests/fixtures/tiny_dataset.npz");
         let ds = Dataset::load(&p).unwrap();
         assert_eq!((ds.len(), ds.n_samples(), ds.n_train), (3, 5, 2));
         assert_eq!(ds.meta.generator, "numpy");

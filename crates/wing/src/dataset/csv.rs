@@ -18,11 +18,12 @@
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-use crate::atomic::write_atomic;
 use crate::dataset::{
     Dataset, DatasetError, DatasetMeta, EULER_NAMES, FORMAT_VERSION, INPUT_NAMES, OUTPUT_NAMES,
     Trajectory,
 };
+use flapssm_data::atomic::write_atomic;
+use flapssm_data::table::split_csv_line;
 
 /// First line of every dataset CSV.
 pub const CSV_MAGIC: &str = "# flapssm-dataset-csv";
@@ -94,37 +95,6 @@ pub fn csv_columns() -> Vec<String> {
     c
 }
 
-/// Splits one CSV line into fields; `"…"` quoting with `""` escapes is understood.
-///
-/// # Errors
-/// A message for an unterminated quote.
-pub(crate) fn split_csv_line(line: &str) -> Result<Vec<String>, String> {
-    let mut out = Vec::new();
-    let mut field = String::new();
-    let mut chars = line.trim_end_matches('\r').chars().peekable();
-    let mut quoted = false;
-    while let Some(c) = chars.next() {
-        match (quoted, c) {
-            (false, ',') => out.push(std::mem::take(&mut field)),
-            (false, '"') if field.trim().is_empty() => {
-                field.clear();
-                quoted = true;
-            }
-            (true, '"') if chars.peek() == Some(&'"') => {
-                chars.next();
-                field.push('"');
-            }
-            (true, '"') => quoted = false,
-            (_, c) => field.push(c),
-        }
-    }
-    if quoted {
-        return Err("unterminated quoted field".into());
-    }
-    out.push(field);
-    Ok(out)
-}
-
 fn quote(s: &str) -> String {
     if s.contains([',', '"', '\n', '\r']) {
         format!("\"{}\"", s.replace('"', "\"\""))
@@ -134,7 +104,7 @@ fn quote(s: &str) -> String {
 }
 
 impl Dataset {
-    /// Writes the dataset as long-format CSV (see [`crate::csv`]) atomically to `path`.
+    /// Writes the dataset as long-format CSV (see [`crate::dataset::csv`]) atomically to `path`.
     ///
     /// # Errors
     /// [`CsvError::Invalid`] if [`Dataset::validate`] fails, [`CsvError::Io`] on I/O failure

@@ -14,6 +14,22 @@
 //! | `pitch_acc` | rad/s² | α̈ |
 //!
 //! Outputs: `F_x`, `F_y` in N; `M_x`, `M_y`, `M_z` in N·mm.
+//!
+//! One dataset type, [`Dataset`], for every flapssm command: per trajectory the Euler angles
+//! (rad), the 7 inputs, the 5 outputs, the sampling period, `U_ref` and a family label, plus
+//! metadata, a train/test split and standardization statistics computed on the training part
+//! only. Its files:
+//! - [`store`]: the dataset file (one self-describing `.npz`), [`Dataset::save`]/[`Dataset::load`].
+//! - [`csv`]: long-format CSV export/import.
+//! - [`published`]: import of the published Bayiz & Cheng dataset layout from a `.mat` file.
+//! - [`summary`]: a printable overview ([`Dataset::summary`]).
+
+pub mod csv;
+pub mod published;
+pub mod store;
+pub mod summary;
+
+pub use store::StoreError;
 
 use serde::{Deserialize, Serialize};
 

@@ -1,7 +1,7 @@
 //! Save/load time of a dataset file of the published size (548 trajectories × 470 samples).
 
 use criterion::{Criterion, black_box, criterion_group, criterion_main};
-use flapssm_data::{Dataset, DatasetMeta, Trajectory};
+use flapssm_wing::dataset::{Dataset, DatasetMeta, Trajectory};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 

@@ -3,7 +3,7 @@
 //! | variable | dimensions | meaning |
 //! |---|---|---|
 //! | `ds_pos` | n_traj × n_t × 3 | stroke, deviation, pitch (rad) |
-//! | `ds_u_raw` | n_traj × n_t × 7 | inputs, [`crate::INPUT_NAMES`] order |
+//! | `ds_u_raw` | n_traj × n_t × 7 | inputs, [`crate::dataset::INPUT_NAMES`] order |
 //! | `ds_y_raw` | n_traj × n_t × 5 | outputs (N, N·mm) |
 //! | `ds_u`, `ds_y` | as above | optional, z-scored copies (shape-checked, not used) |
 //! | `ds_mean_u`, `ds_std_u`, `ds_mean_y`, `ds_std_y` | 1 × 7 / 1 × 5 | optional published statistics, kept in `meta.settings.published_statistics` |
@@ -16,7 +16,7 @@
 use std::path::{Path, PathBuf};
 
 use crate::dataset::{Dataset, DatasetError, DatasetMeta, Trajectory};
-use crate::mat::{MatError, MatFile};
+use flapssm_data::mat::{MatError, MatFile};
 
 /// Sampling period of the published dataset (s).
 pub const PUBLISHED_DT_S: f64 = 0.04;
@@ -163,7 +163,7 @@ mod tests {
 
     fn fixture(name: &str) -> PathBuf {
         Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("tests/fixtures")
+            .join("../data/tests/fixtures")
             .join(name)
     }
 
