@@ -26,7 +26,7 @@ use flapssm_prssm::train::{Checkpoint, LrSchedule};
 use flapssm_qs::{EnetOptions, LrqsmModel};
 use flapssm_wing::dataset::{Dataset, OUTPUT_NAMES};
 use flapssm_wing::features::FeatureSet;
-use flapssm_wing::virtual_wing::{Fidelity, SimulationConfig, simulate_dataset};
+use flapssm_wing::virtual_wing::{Fidelity, SimulationConfig};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{JobError, Result};
@@ -40,6 +40,7 @@ use crate::models::lrqsm::LrqsmLoadModel;
 use crate::models::prssm::PrssmLoadModel;
 use crate::models::{Fit, LoadModel};
 use crate::progress::Progress;
+use crate::simulate::simulate;
 use crate::train::{TrainingOptions, train_prssm};
 use flapssm_analysis::stats::{Interval, median};
 
@@ -326,17 +327,7 @@ pub fn run_demo(
         &k_sim,
         &[&ds_path],
         || load_dataset(&ds_path),
-        |p| {
-            let n = cfg.simulation.trajectories.n_trajectories as u64;
-            p.start("simulate", n);
-            let ds = simulate_dataset(&cfg.simulation, &|| p.advance(1))?;
-            ds.save(&ds_path).map_err(|source| JobError::DatasetFile {
-                path: ds_path.clone(),
-                source,
-            })?;
-            p.finish(&format!("{} trajectories", ds.len()));
-            Ok(ds)
-        },
+        |p| simulate(&cfg.simulation, Some(&ds_path), p),
     )?;
 
     // 2. LRQSM.

@@ -5,6 +5,7 @@
 //!
 //! | module | job |
 //! |---|---|
+//! | [`simulate`] | the virtual wing on seeded random trajectories, into a dataset |
 //! | [`train`] | PR-SSM training on a dataset's training trajectories (settings, checkpoints, resume) |
 //! | [`predict`] | open-loop predictions of every trajectory of a dataset (PR-SSM, LRQSM) |
 //! | [`models`] | the load models behind one trait (PR-SSM, LRQSM, ARX) |
@@ -30,6 +31,7 @@ pub mod models;
 pub mod predict;
 pub mod progress;
 pub mod seed;
+pub mod simulate;
 pub mod sweep;
 pub mod sysid;
 #[cfg(test)]

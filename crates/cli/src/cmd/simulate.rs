@@ -5,10 +5,11 @@ use std::time::Instant;
 
 use anyhow::Context;
 use clap::Args;
-use flapssm_wing::sensor::SensorConfig;
-use flapssm_wing::trajectories::{GeneratorConfig, default_n_train};
-use flapssm_wing::virtual_wing::{Fidelity, SimulationConfig, VirtualWingConfig, simulate_dataset};
-use indicatif::{ProgressBar, ProgressStyle};
+use flapssm_jobs::NoProgress;
+use flapssm_jobs::simulate::{SimulateSettings, simulate};
+use flapssm_wing::virtual_wing::Fidelity;
+
+use crate::progress::Bars;
 
 /// Simulate the robotic wing (aerodynamics + sensor chain) on random trajectories.
 #[derive(Args)]
@@ -43,38 +44,21 @@ pub struct SimulateArgs {
 pub fn run(args: SimulateArgs) -> anyhow::Result<()> {
     let start = Instant::now();
     let fidelity: Fidelity = args.fidelity.parse().context("parsing --fidelity")?;
-    let mut trajectories = GeneratorConfig {
+    let cfg = SimulateSettings {
         n_trajectories: args.n,
-        n_train: args.n_train.unwrap_or_else(|| default_n_train(args.n)),
+        n_train: args.n_train,
         seed: args.seed,
-        ..GeneratorConfig::default()
-    };
-    if args.flat {
-        trajectories.max_deviation_deg = 0.0;
+        fidelity,
+        noise_free: args.noise_free,
+        flat: args.flat,
     }
-    let cfg = SimulationConfig {
-        wing: VirtualWingConfig {
-            fidelity,
-            sensor: if args.noise_free {
-                SensorConfig::noise_free()
-            } else {
-                SensorConfig::default()
-            },
-            ..VirtualWingConfig::default()
-        },
-        trajectories,
-    };
-    let bar = if args.quiet {
-        ProgressBar::hidden()
+    .check()?;
+    let ds = if args.quiet {
+        simulate(&cfg, None, &NoProgress)
     } else {
-        ProgressBar::new(args.n as u64)
-    };
-    bar.set_style(
-        ProgressStyle::with_template("{bar:40} {pos}/{len} trajectories, {elapsed} (eta {eta})")
-            .context("progress bar template")?,
-    );
-    let ds = simulate_dataset(&cfg, &|| bar.inc(1)).context("simulating the wing")?;
-    bar.finish_and_clear();
+        simulate(&cfg, None, &Bars::new())
+    }
+    .context("simulating the wing")?;
     let sim_s = start.elapsed().as_secs_f64();
     ds.save(&args.out)
         .with_context(|| format!("writing dataset {}", args.out.display()))?;

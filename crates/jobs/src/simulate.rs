@@ -1,0 +1,148 @@
+//! `flapssm simulate`: the virtual robotic wing on seeded random trajectories, into a dataset.
+
+use std::path::Path;
+
+use flapssm_wing::dataset::Dataset;
+use flapssm_wing::sensor::SensorConfig;
+use flapssm_wing::trajectories::{GeneratorConfig, default_n_train};
+use flapssm_wing::virtual_wing::{Fidelity, SimulationConfig, VirtualWingConfig, simulate_dataset};
+
+use crate::error::{JobError, Result};
+use crate::progress::Progress;
+
+/// Settings of [`simulate`]: a few choices over [`SimulationConfig::default`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SimulateSettings {
+    /// Trajectories.
+    pub n_trajectories: usize,
+    /// Training trajectories (the first ones); `None`: the published ratio (512 of 548).
+    pub n_train: Option<usize>,
+    /// Seed of the trajectories and the sensor.
+    pub seed: u64,
+    /// Aerodynamic fidelity.
+    pub fidelity: Fidelity,
+    /// Without the sensor chain (no noise, drift, filtering).
+    pub noise_free: bool,
+    /// No stroke deviation (planar strokes).
+    pub flat: bool,
+}
+
+impl Default for SimulateSettings {
+    /// 548 trajectories (512 training), seed 0, the default fidelity, with the sensor.
+    fn default() -> Self {
+        Self {
+            n_trajectories: 548,
+            n_train: None,
+            seed: 0,
+            fidelity: VirtualWingConfig::default().fidelity,
+            noise_free: false,
+            flat: false,
+        }
+    }
+}
+
+impl SimulateSettings {
+    /// Checks the settings and returns the full simulation configuration.
+    ///
+    /// # Errors
+    /// [`JobError::Setting`] for no trajectory or more training trajectories than there are.
+    pub fn check(&self) -> Result<SimulationConfig> {
+        let n = self.n_trajectories;
+        if n == 0 {
+            return Err(JobError::Setting {
+                name: "n".into(),
+                value: "0".into(),
+                expected: "must be at least 1".into(),
+            });
+        }
+        let n_train = self.n_train.unwrap_or_else(|| default_n_train(n));
+        if n_train > n {
+            return Err(JobError::Setting {
+                name: "n_train".into(),
+                value: n_train.to_string(),
+                expected: format!("must be at most the {n} trajectories"),
+            });
+        }
+        let mut trajectories = GeneratorConfig {
+            n_trajectories: n,
+            n_train,
+            seed: self.seed,
+            ..GeneratorConfig::default()
+        };
+        if self.flat {
+            trajectories.max_deviation_deg = 0.0;
+        }
+        Ok(SimulationConfig {
+            wing: VirtualWingConfig {
+                fidelity: self.fidelity,
+                sensor: if self.noise_free {
+                    SensorConfig::noise_free()
+                } else {
+                    SensorConfig::default()
+                },
+                ..VirtualWingConfig::default()
+            },
+            trajectories,
+        })
+    }
+}
+
+/// Simulates `cfg` (`progress.advance(1)` per trajectory) and, with `out`, writes the dataset
+/// file atomically.
+///
+/// # Errors
+/// [`JobError::Simulate`] for a failed simulation, [`JobError::DatasetFile`] naming `out`.
+pub fn simulate(
+    cfg: &SimulationConfig,
+    out: Option<&Path>,
+    progress: &dyn Progress,
+) -> Result<Dataset> {
+    progress.start("simulate", cfg.trajectories.n_trajectories as u64);
+    let ds = simulate_dataset(cfg, &|| progress.advance(1))?;
+    if let Some(path) = out {
+        ds.save(path).map_err(|source| JobError::DatasetFile {
+            path: path.to_path_buf(),
+            source,
+        })?;
+    }
+    progress.finish(&format!("{} trajectories", ds.len()));
+    Ok(ds)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::progress::NoProgress;
+
+    #[test]
+    fn settings_reach_the_configuration_and_bad_ones_are_named() {
+        let cfg = SimulateSettings {
+            n_trajectories: 3,
+            seed: 9,
+            noise_free: true,
+            flat: true,
+            ..SimulateSettings::default()
+        }
+        .check()
+        .unwrap();
+        assert_eq!(cfg.trajectories.n_trajectories, 3);
+        assert_eq!(cfg.trajectories.seed, 9);
+        assert_eq!(cfg.trajectories.max_deviation_deg, 0.0);
+        assert_eq!(cfg.wing.sensor, SensorConfig::noise_free());
+        let ds = simulate(&cfg, None, &NoProgress).unwrap();
+        assert_eq!(ds.len(), 3);
+        for (n, n_train, name) in [
+            (0, None, "setting n = 0"),
+            (4, Some(5), "setting n_train = 5"),
+        ] {
+            let e = SimulateSettings {
+                n_trajectories: n,
+                n_train,
+                ..SimulateSettings::default()
+            }
+            .check()
+            .unwrap_err();
+            assert!(e.to_string().contains(name), "{e}");
+        }
+    }
+}
