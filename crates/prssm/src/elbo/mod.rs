@@ -18,17 +18,16 @@
 //! ([`conditional::tape_len`] values per step); beyond [`TAPE_BUDGET_BYTES`] per chunk, earlier
 //! segments are recomputed from the stored states and draws.
 
-use rand::SeedableRng;
-use rand_chacha::ChaCha8Rng;
-use rand_distr::{Distribution, StandardNormal};
 use serde::{Deserialize, Serialize};
 
-use crate::conditional::{self, ConditionalGrads, ConditionalWorkspace, Posterior};
+use crate::conditional::{ConditionalGrads, ConditionalWorkspace, Posterior};
 use crate::kernel;
 use crate::kl::kl_divergence;
 use crate::objective::{Objective, ObjectiveError, Window};
 use crate::params::{ConfigError, ModelConfig, ParamGrads, Parametrization, Params};
 use crate::tape::TapeMemory;
+
+mod chunk;
 
 /// One training sequence in standardized units.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -551,249 +550,6 @@ impl Elbo {
             g.lengthscales[j] += -2.0 * post.inv_len[j] * cond.len_acc[j];
         }
     }
-
-    #[allow(clippy::too_many_arguments)]
-    fn run_chunk(
-        &self,
-        post: &Posterior,
-        p: &Params,
-        batch: &[Window],
-        chunk: &[usize],
-        init: InitialStates<'_>,
-        seed: u64,
-        lik_scale: f64,
-    ) -> ChunkOut {
-        let cfg = &self.config;
-        let (dx, dy, du, d) = (cfg.n_state, cfg.n_output, cfg.n_input, cfg.n_gp_input());
-        let np = self.options.particles;
-        let nb = chunk.len();
-        let n = nb * np;
-        let t_max = chunk.iter().map(|&i| batch[i].len).max().unwrap_or(0);
-        // Active columns at step t: windows with len > t (chunk sorted by len, descending).
-        let active: Vec<usize> = (0..t_max)
-            .map(|t| chunk.iter().filter(|&&i| batch[i].len > t).count() * np)
-            .collect();
-        let burn: Vec<usize> = chunk
-            .iter()
-            .map(|&i| (self.options.burn_in_fraction * batch[i].len as f64).floor() as usize)
-            .collect();
-        let step = dx * n;
-        let mut scratch = self.scratch.take();
-        let mut xs = std::mem::take(&mut scratch.xs);
-        xs.resize(t_max * step, 0.0);
-        let mut eps = std::mem::take(&mut scratch.eps);
-        eps.resize(t_max.saturating_sub(1) * step, 0.0);
-        let mut eps0 = vec![0.0; step];
-        for (k, &bi) in chunk.iter().enumerate() {
-            let mut rng = ChaCha8Rng::seed_from_u64(seed);
-            rng.set_stream(bi as u64);
-            let cols = k * np..(k + 1) * np;
-            for c in cols.clone() {
-                for dd in 0..dx {
-                    eps0[c * dx + dd] = StandardNormal.sample(&mut rng);
-                }
-            }
-            for t in 0..batch[bi].len - 1 {
-                let e = &mut eps[t * step..(t + 1) * step];
-                for c in cols.clone() {
-                    if cfg.shared_draws {
-                        let v: f64 = StandardNormal.sample(&mut rng);
-                        e[c * dx..(c + 1) * dx].fill(v);
-                    } else {
-                        for dd in 0..dx {
-                            e[c * dx + dd] = StandardNormal.sample(&mut rng);
-                        }
-                    }
-                }
-            }
-            for c in cols {
-                for dd in 0..dx {
-                    xs[c * dx + dd] =
-                        init.mean[bi * dx + dd] + init.std[bi * dx + dd] * eps0[c * dx + dd];
-                }
-            }
-        }
-        let mut ws = match scratch.ws.take() {
-            Some(ws) if ws.capacity() == n => ws,
-            _ => ConditionalWorkspace::new(post, n),
-        };
-        ws.set_input_group(np);
-        let vx = &p.process_noise_var;
-        let vy = &p.obs_noise_var;
-        let jit = cfg.transition_jitter;
-        let fill_input = |ws: &mut ConditionalWorkspace, x: &[f64], t: usize, na: usize| {
-            for c in 0..na {
-                let w = batch[chunk[c / np]];
-                let u = &self.data.sequences[w.sequence].inputs
-                    [(w.start + t) * du..(w.start + t + 1) * du];
-                ws.input[c * d..c * d + dx].copy_from_slice(&x[c * dx..(c + 1) * dx]);
-                ws.input[c * d + dx..(c + 1) * d].copy_from_slice(u);
-            }
-        };
-        let half_log_2pi_v: Vec<f64> = vy
-            .iter()
-            .map(|v| 0.5 * (2.0 * std::f64::consts::PI * v).ln())
-            .collect();
-        let mut nll = 0.0;
-        let mut xbar = vec![0.0; step];
-        let mut vy_bar = vec![0.0; dy];
-        // Likelihood at step t: adds to the loss and (if `grad`) to x̄ and σ̄_y².
-        let likelihood = |x: &[f64], t: usize, xbar: Option<&mut [f64]>, vy_bar: &mut [f64]| {
-            let mut acc = 0.0;
-            let mut xbar = xbar;
-            for (k, &bi) in chunk.iter().enumerate() {
-                let w = batch[bi];
-                if t >= w.len || t < burn[k] {
-                    continue;
-                }
-                let y = &self.data.sequences[w.sequence].outputs
-                    [(w.start + t) * dy..(w.start + t + 1) * dy];
-                for c in k * np..(k + 1) * np {
-                    for dd in 0..dy {
-                        let r = y[dd] - x[c * dx + dd];
-                        acc += half_log_2pi_v[dd] + 0.5 * r * r / vy[dd];
-                        if let Some(xb) = xbar.as_deref_mut() {
-                            xb[c * dx + dd] -= lik_scale * r / vy[dd];
-                            vy_bar[dd] +=
-                                lik_scale * 0.5 * (1.0 / vy[dd] - r * r / (vy[dd] * vy[dd]));
-                        }
-                    }
-                }
-            }
-            acc * lik_scale
-        };
-        // Per-step intermediates for the reverse mode: steps of segment `t / seg` share the
-        // tape; the forward pass leaves the last segment in it, earlier segments are
-        // recomputed from the stored states (identical arithmetic, so identical values).
-        let tape_step = conditional::tape_len(post, n);
-        let n_steps = t_max.saturating_sub(1);
-        let seg = (self.tape_budget_bytes / (8 * tape_step.max(1))).clamp(1, n_steps.max(1));
-        let mut tape_memory = std::mem::take(&mut scratch.tape);
-        let tape = tape_memory.reserve(seg.min(n_steps) * tape_step);
-        // Standard deviations √(σ² + σ_x² + δ) of every step, `(T − 1) × D_x × N`.
-        let mut sds = std::mem::take(&mut scratch.sds);
-        sds.resize(n_steps * step, 0.0);
-        let propagate = |ws: &mut ConditionalWorkspace,
-                         tape: &mut [f64],
-                         xs: &mut [f64],
-                         sds: &mut [f64],
-                         t: usize| {
-            let (cur, next) = xs.split_at_mut((t + 1) * step);
-            let x = &cur[t * step..];
-            let na = active[t + 1];
-            fill_input(ws, x, t, na);
-            ws.forward_tape(post, na, tape);
-            let e = &eps[t * step..];
-            let xn = &mut next[..step];
-            let sd_t = &mut sds[t * step..(t + 1) * step];
-            let k = dx * na;
-            let cols = sd_t[..k]
-                .chunks_exact_mut(dx)
-                .zip(xn[..k].chunks_exact_mut(dx))
-                .zip(x[..k].chunks_exact(dx))
-                .zip(ws.var[..k].chunks_exact(dx))
-                .zip(ws.mean[..k].chunks_exact(dx))
-                .zip(e[..k].chunks_exact(dx));
-            for (((((sd, xn), x), var), mean), e) in cols {
-                for dd in 0..dx {
-                    sd[dd] = (var[dd] + vx[dd] + jit).sqrt();
-                    xn[dd] = x[dd] + mean[dd] + sd[dd] * e[dd];
-                }
-            }
-        };
-        // Forward.
-        for t in 0..t_max {
-            nll += likelihood(&xs[t * step..(t + 1) * step], t, None, &mut vy_bar);
-            if t < n_steps {
-                let slot = (t % seg) * tape_step;
-                propagate(
-                    &mut ws,
-                    &mut tape[slot..slot + tape_step],
-                    &mut xs,
-                    &mut sds,
-                    t,
-                );
-            }
-        }
-        // Backward.
-        let mut cond = ConditionalGrads::zeros(post);
-        let mut vx_bar = vec![0.0; dx];
-        let mut mean_bar = vec![0.0; step];
-        let mut var_bar = vec![0.0; step];
-        let last_seg = n_steps.saturating_sub(1) / seg;
-        for t in (0..t_max).rev() {
-            if t < n_steps {
-                let s = t / seg;
-                if s != last_seg && (t + 1) % seg == 0 {
-                    // Recompute segment s (steps s·seg ..= t) into the tape; the states it
-                    // rewrites come out identical.
-                    for r in s * seg..=t {
-                        let slot = (r % seg) * tape_step;
-                        propagate(
-                            &mut ws,
-                            &mut tape[slot..slot + tape_step],
-                            &mut xs,
-                            &mut sds,
-                            r,
-                        );
-                    }
-                }
-                let na = active[t + 1];
-                let e = &eps[t * step..];
-                let sd_t = &sds[t * step..];
-                let k = dx * na;
-                mean_bar[..k].copy_from_slice(&xbar[..k]);
-                // Elementwise (vectorizes), then the σ_x² adjoint summed in the same order.
-                for (((vb, &xb), &ei), &sd) in var_bar[..k].iter_mut().zip(&xbar).zip(e).zip(sd_t) {
-                    *vb = xb * ei / (2.0 * sd);
-                }
-                for vb in var_bar[..k].chunks_exact(dx) {
-                    vx_bar.iter_mut().zip(vb).for_each(|(a, b)| *a += b);
-                }
-                let slot = (t % seg) * tape_step;
-                ws.backward_tape(
-                    post,
-                    na,
-                    &mut tape[slot..slot + tape_step],
-                    &mean_bar[..dx * na],
-                    &var_bar[..dx * na],
-                    &mut cond,
-                    &mut xbar,
-                );
-            }
-            likelihood(
-                &xs[t * step..(t + 1) * step],
-                t,
-                Some(&mut xbar),
-                &mut vy_bar,
-            );
-        }
-        let mut init_mean = vec![0.0; nb * dx];
-        let mut init_std = vec![0.0; nb * dx];
-        for k in 0..nb {
-            for c in k * np..(k + 1) * np {
-                for dd in 0..dx {
-                    init_mean[k * dx + dd] += xbar[c * dx + dd];
-                    init_std[k * dx + dd] += xbar[c * dx + dd] * eps0[c * dx + dd];
-                }
-            }
-        }
-        self.scratch.put(ChunkScratch {
-            tape: tape_memory,
-            xs,
-            eps,
-            sds,
-            ws: Some(ws),
-        });
-        ChunkOut {
-            nll,
-            cond,
-            process_noise: vx_bar,
-            obs_noise: vy_bar,
-            init_mean,
-            init_std,
-        }
-    }
 }
 
 impl Objective for Elbo {
@@ -842,7 +598,11 @@ impl Objective for Elbo {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::conditional;
     use crate::params::ParamInit;
+    use rand::SeedableRng;
+    use rand_chacha::ChaCha8Rng;
+    use rand_distr::{Distribution, StandardNormal};
 
     /// Recomputing segments of the forward pass in the backward pass (small tape budgets)
     /// gives bit-identical loss and gradient.
