@@ -15,7 +15,7 @@
 //! position), so results do not depend on the thread count. Windows are processed in fixed
 //! chunks of `windows_per_task`, all particles of a chunk batched per step; chunk results are
 //! reduced in chunk order. The backward pass reads each step's intermediates from a tape
-//! ([`conditional::tape_len`] values per step); beyond [`TAPE_BUDGET_BYTES`] per chunk, earlier
+//! ([`crate::conditional::tape_len`] values per step); beyond [`TAPE_BUDGET_BYTES`] per chunk, earlier
 //! segments are recomputed from the stored states and draws.
 
 use serde::{Deserialize, Serialize};

@@ -1,0 +1,148 @@
+//! The prediction conditional: forward only, no tape.
+
+use faer::Accum;
+
+use super::Posterior;
+use crate::kernel;
+use crate::linalg::{dot, gemm, view, view_mut};
+use crate::params::CovarianceStructure;
+
+/// Forward-only conditional for prediction (no derivatives, no tape). `W` and the means come
+/// from one product `[W; μ] = [G; mᵀG] K` (`(M + D_x) × N`); `σ²` as in [`ConditionalWorkspace`].
+#[derive(Debug, Clone)]
+pub(crate) struct PredictiveWorkspace {
+    cap: usize,
+    group: usize,
+    /// GP inputs `[x; u]`, column-major `D × N` (filled by the caller).
+    pub input: Vec<f64>,
+    xs: Vec<f64>,
+    k: Vec<f64>,
+    /// `[W; μ]`, column-major `(M + D_x) × N`.
+    wm: Vec<f64>,
+    w2: Vec<f64>,
+    tau_shared: Vec<f64>,
+    /// Variances `σ²`, column-major `D_x × N`.
+    pub var: Vec<f64>,
+}
+
+impl PredictiveWorkspace {
+    /// Buffers for up to `capacity` points whose consecutive groups of `group` share the
+    /// input part `u` (see [`ConditionalWorkspace::set_input_group`]).
+    pub(crate) fn new(post: &Posterior, capacity: usize, group: usize) -> Self {
+        let (m, d, dx, n) = (post.m, post.d, post.dx, capacity);
+        Self {
+            cap: n,
+            group: group.max(1),
+            input: vec![0.0; d * n],
+            xs: vec![0.0; d * n],
+            k: vec![0.0; m * n],
+            wm: vec![0.0; (m + dx) * n],
+            w2: vec![0.0; m * n],
+            tau_shared: vec![0.0; m],
+            var: vec![0.0; dx * n],
+        }
+    }
+
+    /// Means `μ` of the last [`Self::forward`]: column `n` is `mean(n)` (`D_x` values).
+    #[inline]
+    pub(crate) fn mean(&self, post: &Posterior, n: usize) -> &[f64] {
+        let r = post.m + post.dx;
+        &self.wm[n * r + post.m..(n + 1) * r]
+    }
+
+    /// Computes `μ` and `σ²` at the first `n` columns of [`Self::input`]. Allocates nothing.
+    pub(crate) fn forward(&mut self, post: &Posterior, n: usize) {
+        let (m, d, dx) = (post.m, post.d, post.dx);
+        debug_assert!(n <= self.cap);
+        let r = m + dx;
+        kernel::scale_points(&self.input[..d * n], &post.inv_len, &mut self.xs[..d * n]);
+        kernel::cross_cov_grouped_values(
+            post.kind,
+            post.variance,
+            post.tau_jitter,
+            &post.zt,
+            &self.xs[..d * n],
+            d,
+            (dx, self.group),
+            &mut self.k[..m * n],
+            &mut self.tau_shared,
+        );
+        gemm(
+            view_mut(&mut self.wm, r, n),
+            Accum::Replace,
+            post.g_mean(),
+            view(&self.k, m, n),
+            1.0,
+        );
+        let k = if post.whitened {
+            None
+        } else {
+            Some(&self.k[..])
+        };
+        write_predictive_variance(post, &self.wm, r, k, n, &mut self.w2, &mut self.var, None);
+    }
+}
+
+/// Writes the predictive variances of `n` points into `var` (`D_x × N`, column-major):
+/// `σ²_d(n) = k** − w_nᵀh_n + Σ_i S_d,ii w_in²` (diagonal `S`) or `+ ‖L_dᵀw_n‖²` (full
+/// `S_d = L_dL_dᵀ`), with `w_n` the first `M` entries of column `n` of `w` (column stride
+/// `stride ≥ M`) and `h_n = k_n` (column `n` of `k`, `M × N`) or `w_n` when `k` is `None`
+/// (whitened). With `quad`, also writes `σ²_d(n) − k** = Σ_i … − w_nᵀh_n` there (`D_x × N`).
+/// `w2` (`M × N`) is scratch. Allocates nothing.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn write_predictive_variance(
+    post: &Posterior,
+    w: &[f64],
+    stride: usize,
+    k: Option<&[f64]>,
+    n: usize,
+    w2: &mut [f64],
+    var: &mut [f64],
+    mut quad: Option<&mut [f64]>,
+) {
+    let (m, dx) = (post.m, post.dx);
+    let w_view = view(&w[..stride * n], stride, n).subrows(0, m);
+    match post.cov {
+        CovarianceStructure::Diagonal => {
+            for (c2, wc) in w2[..m * n].chunks_exact_mut(m).zip(w.chunks(stride)) {
+                c2.iter_mut().zip(&wc[..m]).for_each(|(a, &b)| *a = b * b);
+            }
+            gemm(
+                view_mut(var, dx, n),
+                Accum::Replace,
+                view(&post.q_cov, dx, m),
+                view(w2, m, n),
+                1.0,
+            )
+        }
+        CovarianceStructure::Full => {
+            for dd in 0..dx {
+                let ld = &post.q_cov[dd * m * m..(dd + 1) * m * m];
+                gemm(
+                    view_mut(w2, m, n),
+                    Accum::Replace,
+                    view(ld, m, m).transpose(),
+                    w_view,
+                    1.0,
+                );
+                for j in 0..n {
+                    let c = &w2[j * m..(j + 1) * m];
+                    var[j * dx + dd] = dot(c, c);
+                }
+            }
+        }
+    }
+    for (j, v) in var[..dx * n].chunks_exact_mut(dx).enumerate() {
+        let wc = &w[j * stride..j * stride + m];
+        let hc = k.map_or(wc, |k| &k[j * m..(j + 1) * m]);
+        let wh = dot(wc, hc);
+        if let Some(q) = quad.as_deref_mut() {
+            q[j * dx..(j + 1) * dx]
+                .iter_mut()
+                .zip(v.iter())
+                .for_each(|(q, &v)| *q = v - wh);
+        }
+        let base = post.variance - wh;
+        v.iter_mut().for_each(|v| *v += base);
+    }
+}
