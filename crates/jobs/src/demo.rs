@@ -302,6 +302,7 @@ pub fn run_demo(
     let t_all = Instant::now();
     let plan = cfg.training.check()?;
     let arx_fit = cfg.arx.check()?;
+    cfg.evaluation.check()?;
     std::fs::create_dir_all(dir).map_err(|source| JobError::Io {
         path: dir.to_path_buf(),
         source,

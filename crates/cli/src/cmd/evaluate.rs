@@ -55,6 +55,7 @@ pub fn run(a: EvaluateArgs) -> anyhow::Result<()> {
         start_sample: a.start_sample,
         ..EvalOptions::default()
     };
+    opts.check()?;
     let arx_fit = a.arx.then(|| ArxSettings::default().check()).transpose()?;
     let ds = Dataset::load(&a.dataset)
         .with_context(|| format!("loading dataset {}", a.dataset.display()))?;

@@ -88,6 +88,54 @@ impl Default for EvalOptions {
     }
 }
 
+impl EvalOptions {
+    /// Checks the settings that do not depend on the dataset (`start_sample` is checked against
+    /// the dataset by [`evaluate`]).
+    ///
+    /// # Errors
+    /// [`JobError::Setting`] for no particles, a level outside (0, 100), or authority settings
+    /// out of range, named as the user gives them.
+    pub fn check(&self) -> Result<()> {
+        let bad = |name: &str, value: String, expected: &str| {
+            Err(JobError::Setting {
+                name: name.into(),
+                value,
+                expected: expected.into(),
+            })
+        };
+        if self.particles == 0 {
+            return bad("particles", "0".into(), "must be at least 1");
+        }
+        if !(self.level > 0.0 && self.level < 100.0) {
+            return bad("level", self.level.to_string(), "must be in (0, 100) %");
+        }
+        let a = &self.authority;
+        if a.num_lags == 0 || a.grid_points < 2 {
+            return bad(
+                "authority",
+                format!("num_lags {}, grid_points {}", a.num_lags, a.grid_points),
+                "num_lags ≥ 1 and grid_points ≥ 2",
+            );
+        }
+        for (name, v) in [
+            ("authority.max_lag_cycles", a.max_lag_cycles),
+            ("authority.bandwidth", a.bandwidth),
+        ] {
+            if !(v > 0.0 && v.is_finite()) {
+                return bad(name, v.to_string(), "must be positive and finite");
+            }
+        }
+        if !(a.hdr_mass > 0.0 && a.hdr_mass < 1.0) {
+            return bad(
+                "authority.hdr_mass",
+                a.hdr_mass.to_string(),
+                "must be in (0, 1)",
+            );
+        }
+        Ok(())
+    }
+}
+
 /// Accuracy of one model on one set of trajectories.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SplitMetrics {
@@ -341,6 +389,7 @@ pub fn evaluate(
 
 /// Checks the inputs once, before any prediction.
 fn check(ds: &Dataset, models: &[&dyn LoadModel], opts: &EvalOptions) -> Result<()> {
+    opts.check()?;
     ds.validate()?;
     if !ds.has_outputs() {
         return Err(flapssm_wing::dataset::DatasetError::NoOutputs.into());
@@ -856,5 +905,29 @@ mod tests {
         )
         .unwrap_err();
         assert!(e.to_string().contains("models to evaluate"), "{e}");
+    }
+
+    #[test]
+    fn evaluation_settings_are_checked_and_named() {
+        let err = |o: EvalOptions| o.check().unwrap_err().to_string();
+        assert!(EvalOptions::default().check().is_ok());
+        let e = err(EvalOptions {
+            particles: 0,
+            ..EvalOptions::default()
+        });
+        assert!(e.contains("setting particles = 0"), "{e}");
+        let e = err(EvalOptions {
+            level: 100.0,
+            ..EvalOptions::default()
+        });
+        assert!(e.contains("setting level = 100"), "{e}");
+        let e = err(EvalOptions {
+            authority: AuthorityConfig {
+                hdr_mass: 1.5,
+                ..AuthorityConfig::default()
+            },
+            ..EvalOptions::default()
+        });
+        assert!(e.contains("authority.hdr_mass"), "{e}");
     }
 }
