@@ -4,8 +4,11 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use clap::{Args, Subcommand, ValueEnum};
+use flapssm_jobs::NoProgress;
+use flapssm_jobs::models::Fit;
+use flapssm_jobs::models::lrqsm::{LrqsmFit, predict_file};
 use flapssm_qs::cv::{EnetOptions, FoldLayout, LambdaRule};
-use flapssm_qs::lrqsm::{Rmse, fit_dataset, predict_dataset};
+use flapssm_qs::lrqsm::Rmse;
 use flapssm_qs::table::{fit_table, read_csv};
 use flapssm_qs::{InterceptMode, LrqsmModel};
 use flapssm_wing::dataset::Dataset;
@@ -163,18 +166,18 @@ fn load_dataset(path: &Path) -> Result<Dataset> {
 
 fn fit(a: FitArgs) -> Result<()> {
     let ds = load_dataset(&a.dataset)?;
-    let set = match a.features {
-        Features::Published => FeatureSet::Published,
-        Features::PaperText => FeatureSet::PaperText,
+    let fit = LrqsmFit {
+        features: match a.features {
+            Features::Published => FeatureSet::Published,
+            Features::PaperText => FeatureSet::PaperText,
+        },
+        options: a.path.options(),
+        source: a.dataset.display().to_string(),
     };
-    let model = fit_dataset(
-        &ds,
-        set,
-        &a.path.options(),
-        &a.dataset.display().to_string(),
-    )
-    .with_context(|| format!("fitting the LRQSM on {}", a.dataset.display()))?;
-    finish(&model, &a.out, a.path.json)
+    let model = fit
+        .fit(&ds, &NoProgress)
+        .with_context(|| format!("fitting the LRQSM on {}", a.dataset.display()))?;
+    finish(model.model(), &a.out, a.path.json)
 }
 
 fn fit_csv(a: FitCsvArgs) -> Result<()> {
@@ -264,15 +267,14 @@ fn predict(a: PredictArgs) -> Result<()> {
     } else {
         InterceptMode::Fitted
     };
-    let pred = predict_dataset(&model, &ds, mode).with_context(|| {
+    let pred = predict_file(&model, &ds, mode, &a.out).with_context(|| {
         format!(
-            "applying model {} to {}",
+            "applying model {} to {} (predictions {})",
             a.model.display(),
-            a.dataset.display()
+            a.dataset.display(),
+            a.out.display()
         )
     })?;
-    pred.save_npz(&a.out)
-        .with_context(|| format!("writing predictions {}", a.out.display()))?;
     let show = |label: &str, r: &Option<Rmse>| {
         let Some(r) = r else {
             println!("{label}: no samples with outputs");

@@ -2,8 +2,9 @@
 //! intercept, in the dataset's units.
 
 use std::borrow::Cow;
+use std::path::Path;
 
-use flapssm_qs::lrqsm::{fit_dataset, trajectory_features};
+use flapssm_qs::lrqsm::{DatasetPrediction, fit_dataset, predict_dataset, trajectory_features};
 use flapssm_qs::{EnetOptions, InterceptMode, LrqsmModel};
 use flapssm_wing::dataset::{Dataset, OUTPUT_NAMES, Trajectory};
 use flapssm_wing::features::FeatureSet;
@@ -102,6 +103,23 @@ impl LoadModel for LrqsmLoadModel<'_> {
         }
         Ok(())
     }
+}
+
+/// `flapssm qs predict`: the LRQSM's predictions of every trajectory of `ds` with its RMSE on
+/// the training and test parts ([`predict_dataset`], intercept as `mode` says), written to `out`
+/// (.npz, atomically).
+///
+/// # Errors
+/// [`JobError::Qs`] for a model that does not fit the dataset or a file that cannot be written.
+pub fn predict_file(
+    model: &LrqsmModel,
+    ds: &Dataset,
+    mode: InterceptMode,
+    out: &Path,
+) -> Result<DatasetPrediction> {
+    let p = predict_dataset(model, ds, mode)?;
+    p.save_npz(out)?;
+    Ok(p)
 }
 
 /// Fits the LRQSM ([`fit_dataset`]) with a feature set and elastic-net options.
