@@ -233,14 +233,13 @@ impl<'a> Chunk<'a> {
         }
     }
 
-    /// Likelihood at step `t` (scaled): its value, and with `xbar` its adjoints added to `x̄`
-    /// and `σ̄_y²`.
+    /// Likelihood at step `t` (scaled): its value, and with `adjoints = (x̄, σ̄_y²)` its
+    /// adjoints added to them.
     fn likelihood(
         &self,
         x: &[f64],
         t: usize,
-        mut xbar: Option<&mut [f64]>,
-        vy_bar: &mut [f64],
+        mut adjoints: Option<(&mut [f64], &mut [f64])>,
     ) -> f64 {
         let (dx, dy, ..) = self.dims;
         let (vy, np, lik_scale) = (self.vy, self.np, self.lik_scale);
@@ -256,7 +255,7 @@ impl<'a> Chunk<'a> {
                 for dd in 0..dy {
                     let r = y[dd] - x[c * dx + dd];
                     acc += self.half_log_2pi_v[dd] + 0.5 * r * r / vy[dd];
-                    if let Some(xb) = xbar.as_deref_mut() {
+                    if let Some((xb, vy_bar)) = adjoints.as_mut() {
                         xb[c * dx + dd] -= lik_scale * r / vy[dd];
                         vy_bar[dd] += lik_scale * 0.5 * (1.0 / vy[dd] - r * r / (vy[dd] * vy[dd]));
                     }
@@ -307,10 +306,9 @@ impl<'a> Chunk<'a> {
     fn forward(&self, b: &mut Buffers) -> f64 {
         let (step, tape_step, seg) = (self.step, self.tape_step, self.seg);
         let tape = b.tape.reserve(seg.min(self.n_steps) * tape_step);
-        let mut vy_unused = vec![0.0; self.dims.1];
         let mut nll = 0.0;
         for t in 0..self.t_max {
-            nll += self.likelihood(&b.xs[t * step..(t + 1) * step], t, None, &mut vy_unused);
+            nll += self.likelihood(&b.xs[t * step..(t + 1) * step], t, None);
             if t < self.n_steps {
                 let slot = (t % seg) * tape_step;
                 self.propagate(
@@ -386,8 +384,7 @@ impl<'a> Chunk<'a> {
             self.likelihood(
                 &b.xs[t * step..(t + 1) * step],
                 t,
-                Some(&mut adj.xbar),
-                &mut adj.vy_bar,
+                Some((&mut adj.xbar, &mut adj.vy_bar)),
             );
         }
         adj
