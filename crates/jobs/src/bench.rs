@@ -6,7 +6,7 @@ use flapssm_prssm::train::bench::{
     REFERENCE_SOLVE_S, gemm_rate_gflops, initial_model, predict_step_flops,
     reference_solve_seconds, synthetic_objective, time_batches, time_prediction, time_stream_step,
 };
-use flapssm_prssm::train::fit::{FitSpec, Preset};
+use flapssm_prssm::train::fit::{FitError, FitSpec, Preset};
 
 use crate::error::{JobError, Result};
 use crate::threads::current_threads;
@@ -97,25 +97,24 @@ pub fn bench(settings: &BenchSettings) -> Result<BenchReport> {
             expected: "must be at least 1".into(),
         });
     }
-    let engine = |what: &str, e: &dyn std::fmt::Display| JobError::Mismatch {
+    let engine = |what: &str, source: FitError| JobError::Prssm {
         what: format!("bench: {what}"),
-        expected: "a run of the engine".into(),
-        found: e.to_string(),
+        source,
     };
     let spec = FitSpec::preset(Preset::Paper, 7, 5);
     let gemm_gflops = gemm_rate_gflops(512, 0.3);
     let reference_solve_s = reference_solve_seconds(0.2);
     let (elbo, params) = synthetic_objective(&spec, TRAIN_SEQUENCES, PREDICT_STEPS, settings.seed)
-        .map_err(|e| engine("building the paper objective", &e))?;
+        .map_err(|e| engine("building the paper objective", e.into()))?;
     let times = time_batches(&elbo, &params, settings.batches, settings.seed)
-        .map_err(|e| engine("timing training batches", &e))?;
+        .map_err(|e| engine("timing training batches", e.into()))?;
     let per_epoch = BATCHES_PER_EPOCH as f64 / settings.batches as f64;
     let model = initial_model(&spec, settings.seed);
     let predict_s = time_prediction(&model, PREDICT_STEPS, spec.particles, settings.reps)
-        .map_err(|e| engine("timing prediction", &e))?;
+        .map_err(|e| engine("timing prediction", e.into()))?;
     let step_flops = predict_step_flops(&model.config, spec.particles);
     let stream_step_s = time_stream_step(&model, spec.particles, 2000)
-        .map_err(|e| engine("timing streaming", &e))?;
+        .map_err(|e| engine("timing streaming", e.into()))?;
     Ok(BenchReport {
         threads: current_threads(),
         gemm_gflops,

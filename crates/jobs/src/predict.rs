@@ -1,5 +1,5 @@
-//! Open-loop predictions of every trajectory of a dataset: the PR-SSM (mean, variance, latent
-//! means) and the LRQSM.
+//! Open-loop predictions of the PR-SSM: every trajectory of a dataset (mean, variance, latent
+//! moments), or one table of inputs.
 //!
 //! PR-SSM draws: trajectory `i` uses seed [`crate::seed::prediction_seed`]`(seed, i)`, so the
 //! same seed gives the same draws whichever job predicts.
@@ -11,7 +11,6 @@ use flapssm_prssm::predict::Prediction;
 use flapssm_prssm::train::InitialStateSpec;
 use flapssm_prssm::train::fit::training_record;
 use flapssm_prssm::{PrssmModel, Sequence};
-use flapssm_qs::{InterceptMode, LrqsmModel};
 use flapssm_wing::dataset::{Dataset, Trajectory};
 
 use crate::error::{JobError, Result};
@@ -19,11 +18,6 @@ use crate::models::map_trajectories;
 use crate::models::prssm::PrssmLoadModel;
 use crate::progress::Progress;
 use crate::seed::prediction_seed;
-
-/// PR-SSM open-loop prediction of one trajectory: output means (N, N·mm) and variances
-/// (N², (N·mm)²), row-major `n × 5`; latent means and variances (standardized latent units),
-/// `n × D_x`.
-pub type PrssmPrediction = Prediction;
 
 /// The raw PR-SSM sequence of a trajectory (7 inputs, 5 outputs, row-major; outputs empty for
 /// kinematics-only trajectories).
@@ -43,7 +37,7 @@ pub fn trajectory_sequence(t: &Trajectory) -> Sequence {
 /// that standardizes with `ds`'s training statistics, as the published post-processing did.
 ///
 /// # Errors
-/// [`JobError::Dataset`] when the model has no statistics and `ds` has no outputs to
+/// [`JobError::Mismatch`] when the model has no statistics and `ds` has no outputs to
 /// compute them from.
 pub fn in_dataset_units<'m>(
     model: &'m PrssmModel,
@@ -51,6 +45,13 @@ pub fn in_dataset_units<'m>(
 ) -> Result<std::borrow::Cow<'m, PrssmModel>> {
     if model.normalization.is_some() {
         return Ok(std::borrow::Cow::Borrowed(model));
+    }
+    if !ds.has_outputs() {
+        return Err(JobError::Mismatch {
+            what: "PR-SSM model without normalization statistics".into(),
+            expected: "a dataset with outputs to standardize with".into(),
+            found: "a dataset with no outputs".into(),
+        });
     }
     let s = ds.standardization()?;
     let mut m = model.clone();
@@ -64,7 +65,9 @@ pub fn in_dataset_units<'m>(
 }
 
 /// Predicts every trajectory of `ds` with the PR-SSM (in parallel with feature `parallel`;
-/// results do not depend on threading). `progress.advance(1)` per trajectory.
+/// results do not depend on threading): output means (N, N·mm) and variances, row-major
+/// `n × 5`; latent means and variances (standardized), `n × D_x`. `progress.advance(1)` per
+/// trajectory.
 ///
 /// # Errors
 /// [`JobError::Mismatch`] for a model that is not 7 → 5, [`JobError::Prssm`] naming
@@ -75,23 +78,13 @@ pub fn predict_prssm(
     particles: usize,
     seed: u64,
     progress: &dyn Progress,
-) -> Result<Vec<PrssmPrediction>> {
+) -> Result<Vec<Prediction>> {
     let model = PrssmLoadModel::new(model, ds, particles, seed)?;
     map_trajectories(ds, |i, t| {
         let p = model.predict(i, t)?;
         progress.advance(1);
         Ok(p)
     })
-}
-
-/// LRQSM predictions (N, N·mm) of every trajectory, one `n × 5` table each.
-///
-/// # Errors
-/// [`JobError::Qs`] for a model that does not fit the dataset.
-pub fn predict_lrqsm(model: &LrqsmModel, ds: &Dataset) -> Result<Vec<Vec<f64>>> {
-    let p = flapssm_qs::lrqsm::predict_dataset(model, ds, InterceptMode::Fitted)?;
-    let per = p.n_samples * 5;
-    Ok(p.raw.chunks_exact(per).map(<[f64]>::to_vec).collect())
 }
 
 /// What [`predict_dataset_file`] did.
@@ -125,13 +118,6 @@ pub fn predict_dataset_file(
 ) -> Result<DatasetPredictionSummary> {
     let mut notes = Vec::new();
     if model.normalization.is_none() {
-        if !ds.has_outputs() {
-            return Err(JobError::Mismatch {
-                what: "PR-SSM model without normalization statistics".into(),
-                expected: "a dataset with outputs to standardize with".into(),
-                found: "a dataset with no outputs".into(),
-            });
-        }
         notes.push(
             "the model has no normalization statistics; standardizing with the dataset's \
              training statistics"

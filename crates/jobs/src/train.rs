@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 
 use flapssm_prssm::Sequence;
-use flapssm_prssm::train::fit::{FitOutcome, FitSpec, Preset, fit};
+use flapssm_prssm::train::fit::{FitError, FitOutcome, FitSpec, Preset, fit};
 use flapssm_prssm::train::{Budget, Checkpoint, LrSchedule, TrainEvent, TrainHooks};
 use flapssm_wing::dataset::{Dataset, Trajectory};
 use serde::{Deserialize, Serialize};
@@ -142,6 +142,11 @@ impl TrainingOptions {
                 return bad(name, "0".into(), "must be at least 1");
             }
         }
+        if let Some(lr) = self.lr
+            && !(lr > 0.0 && lr.is_finite())
+        {
+            return bad("lr", lr.to_string(), "must be positive and finite");
+        }
         let spec = self.spec();
         let m = &spec.model;
         if m.n_state < m.n_output {
@@ -154,16 +159,14 @@ impl TrainingOptions {
                 ),
             );
         }
-        m.check().map_err(|e| JobError::Setting {
-            name: e.field.into(),
-            value: String::new(),
-            expected: e.message,
-        })?;
-        spec.train.check().map_err(|e| JobError::Setting {
-            name: "training".into(),
-            value: String::new(),
-            expected: e.to_string(),
-        })?;
+        // What the flags cannot reach (jitters, Adam and divergence settings): the engine's own
+        // checks, naming its fields.
+        let engine = |source: FitError| JobError::Prssm {
+            what: "training settings".into(),
+            source,
+        };
+        m.check().map_err(|e| engine(e.into()))?;
+        spec.train.check().map_err(|e| engine(e.into()))?;
         Ok(TrainingPlan {
             spec,
             val_fraction: self.val_fraction,
@@ -212,14 +215,12 @@ impl TrainingPlan {
     /// # Errors
     /// [`JobError::Dataset`] when there is no training trajectory.
     pub fn describe(&self, train: &[Trajectory]) -> Result<String> {
-        let (a, b) = self.split(train)?;
-        Ok(self.describe_split(a.len(), b.len()))
-    }
-
-    fn describe_split(&self, n_fit: usize, n_val: usize) -> String {
+        let (fit, val) = self.split(train)?;
         let s = &self.spec;
-        format!(
-            "{n_fit} training / {n_val} validation trajectories; D_x {}, M {}, {} particles, {}",
+        Ok(format!(
+            "{} training / {} validation trajectories; D_x {}, M {}, {} particles, {}",
+            fit.len(),
+            val.len(),
             s.model.n_state,
             s.model.n_inducing,
             s.particles,
@@ -227,7 +228,7 @@ impl TrainingPlan {
                 Budget::Epochs(n) => format!("{n} epochs"),
                 Budget::Iterations(n) => format!("{n} iterations"),
             }
-        )
+        ))
     }
 }
 
@@ -345,12 +346,6 @@ fn sibling(path: &Path, suffix: &str) -> PathBuf {
 /// What a finished [`train_dataset`] did.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TrainSummary {
-    /// Trajectories fitted.
-    pub n_fit: usize,
-    /// Trajectories held out for validation.
-    pub n_val: usize,
-    /// [`TrainingPlan::describe`] of the run.
-    pub description: String,
     /// Optimizer steps done.
     pub steps: u64,
     /// Steps rejected (non-finite or diverging) and retried.
@@ -377,8 +372,6 @@ pub fn train_dataset(
     if !ds.has_outputs() {
         return Err(flapssm_wing::dataset::DatasetError::NoOutputs.into());
     }
-    let (n_fit, n_val) = plan.split(ds.train()).map(|(a, b)| (a.len(), b.len()))?;
-    let description = plan.describe_split(n_fit, n_val);
     let resume = if resume {
         Some(
             Checkpoint::load(&files.checkpoint).map_err(|e| JobError::Io {
@@ -407,9 +400,6 @@ pub fn train_dataset(
     progress.finish(&format!("{} steps", out.outcome.state.step));
     let state = &out.outcome.state;
     Ok(TrainSummary {
-        n_fit,
-        n_val,
-        description,
         steps: state.step,
         rejected: state.rejected,
         best: state.best.as_ref().map(|b| (b.epoch, b.score)),
@@ -464,7 +454,7 @@ mod tests {
             lr: Some(-1.0),
             ..TrainingOptions::default()
         });
-        assert!(e.contains("lr"), "{e}");
+        assert!(e.contains("setting lr = -1: must be positive"), "{e}");
         assert!(
             TrainingOptions {
                 dx: Some(5),

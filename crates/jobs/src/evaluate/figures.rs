@@ -110,10 +110,9 @@ pub(super) fn draw_fig3(
         .collect::<Result<_>>()?;
     let names: Vec<String> = models
         .iter()
-        .zip(&data.first().map_or(&Vec::new(), |d| &d.models).to_vec())
-        .map(|(m, (_, std))| match std {
-            Some(_) => format!("{} ±2σ", m.name()),
-            None => m.name().to_string(),
+        .map(|m| match m.has_variance() {
+            true => format!("{} ±2σ", m.name()),
+            false => m.name().to_string(),
         })
         .collect();
     let curves: Vec<Vec<pt::CoefficientCurves<'_>>> = data

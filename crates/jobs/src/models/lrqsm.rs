@@ -87,9 +87,9 @@ impl LoadModel for LrqsmLoadModel<'_> {
     ) -> Result<()> {
         let n = trajectory.inputs.len();
         check_buffer("LRQSM mean", out.mean, n, 5)?;
-        let Some(scaling) = &self.model.target_scaling else {
-            unreachable!("checked by LrqsmLoadModel::new")
-        };
+        let scaling = self.model.target_scaling.as_ref().ok_or_else(|| {
+            flapssm_qs::QsError::Mismatch("the model has no target scaling".into())
+        })?;
         let x = trajectory_features(std::slice::from_ref(trajectory), self.features);
         let mut z = [0.0; 5];
         for (row, y) in x

@@ -65,6 +65,16 @@ impl<'m> PrssmLoadModel<'m> {
         &self.model
     }
 
+    /// The same, owning its model.
+    pub fn into_owned(self) -> PrssmLoadModel<'static> {
+        PrssmLoadModel {
+            model: Cow::Owned(self.model.into_owned()),
+            particles: self.particles,
+            seed: self.seed,
+            history: self.history,
+        }
+    }
+
     /// The full open-loop prediction of trajectory `index` (latent variances included): the
     /// one prediction path of the PR-SSM in every job.
     ///
@@ -153,12 +163,47 @@ impl Fit for PrssmFit {
 
     fn fit(&self, ds: &Dataset, progress: &dyn Progress) -> Result<Self::Model> {
         let out = train_prssm(ds.train(), &self.plan, None, None, progress, None)?;
-        let mut m = PrssmLoadModel::new(&out.best, ds, self.particles, self.seed)?;
-        Ok(PrssmLoadModel {
-            model: Cow::Owned(m.model.to_mut().clone()),
-            particles: m.particles,
-            seed: m.seed,
-            history: m.history.take(),
-        })
+        Ok(PrssmLoadModel::new(&out.best, ds, self.particles, self.seed)?.into_owned())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::progress::NoProgress;
+    use crate::test_data::tiny_dataset;
+    use crate::train::TrainingOptions;
+
+    /// `PrssmFit` is `train_prssm` followed by [`PrssmLoadModel::new`]: the same parameters,
+    /// its training history kept, and the same prediction of a trajectory.
+    #[test]
+    fn fit_trains_and_wraps_the_best_model() {
+        let ds = tiny_dataset();
+        let plan = TrainingOptions {
+            dx: Some(5),
+            inducing: Some(6),
+            particles: Some(3),
+            epochs: Some(2),
+            val_fraction: 0.0,
+            ..TrainingOptions::default()
+        }
+        .check()
+        .unwrap();
+        let fitted = PrssmFit {
+            plan: plan.clone(),
+            particles: 4,
+            seed: 2,
+        }
+        .fit(&ds, &NoProgress)
+        .unwrap();
+        let out = train_prssm(ds.train(), &plan, None, None, &NoProgress, None).unwrap();
+        assert_eq!(fitted.model().params, out.best.params);
+        assert_eq!(fitted.training_history().map(<[_]>::len), Some(2));
+        let direct = PrssmLoadModel::new(&out.best, &ds, 4, 2).unwrap();
+        let t = &ds.trajectories[5];
+        assert_eq!(
+            fitted.predict(5, t).unwrap().output_mean,
+            direct.predict(5, t).unwrap().output_mean
+        );
     }
 }
