@@ -11,6 +11,7 @@
 //!    its interquartile range (MATLAB `median`/`iqr`). Pairs with median `|r| > strong_median_r`
 //!    are "strong": the paper prints their median lag ([`AuthoritySummary`]).
 
+use rayon::prelude::*;
 use std::io::Write;
 use std::path::Path;
 
@@ -161,7 +162,7 @@ impl PeakTable {
 }
 
 /// Computes the peak table. Per trajectory the series are standardized once; the lag loop is
-/// allocation-free. Trajectories run in parallel with the `parallel` feature; results do not
+/// allocation-free. Trajectories run in parallel on the caller's rayon pool; results do not
 /// depend on it.
 ///
 /// # Errors
@@ -231,14 +232,8 @@ pub fn peak_table(
         }
         Ok(out)
     };
-    #[cfg(feature = "parallel")]
-    let rows: Vec<Result<Vec<Option<PeakCorrelation>>>> = {
-        use rayon::prelude::*;
-        trajectories.par_iter().enumerate().map(one).collect()
-    };
-    #[cfg(not(feature = "parallel"))]
     let rows: Vec<Result<Vec<Option<PeakCorrelation>>>> =
-        trajectories.iter().enumerate().map(one).collect();
+        trajectories.par_iter().enumerate().map(one).collect();
     let mut peaks = Vec::with_capacity(trajectories.len() * n_state * n_input);
     for r in rows {
         peaks.extend(r?);

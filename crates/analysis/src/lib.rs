@@ -14,9 +14,9 @@
 //! | [`plots`] | PNG/SVG figures (Figs. 2C, 3, 4, 5, training curves) | — |
 //! | [`report`] | one self-contained HTML page | — |
 //!
-//! Features (both default): `parallel` runs the per-trajectory cross-correlations on rayon;
-//! `plots` builds [`plots`] (plotters, an embedded font, PNG encoding). Without it the crate is
-//! the analyses and the HTML report alone.
+//! Feature `plots` (default) builds [`plots`] (plotters, an embedded font, PNG encoding). Without
+//! it the crate is the analyses and the HTML report alone. Per-trajectory loops run on the
+//! caller's rayon pool; results do not depend on its size.
 #![warn(missing_docs)]
 
 pub mod authority;

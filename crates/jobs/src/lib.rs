@@ -18,8 +18,6 @@
 //! Shared pieces: [`error`] (one error type naming the file, trajectory or stage), [`progress`]
 //! (the progress sink a caller supplies), [`seed`] (the one seed-derivation rule), [`files`]
 //! (atomic JSON and text files), [`threads`] (the pool a job runs on).
-//!
-//! Features: `parallel` (default) predicts trajectories and runs restarts on rayon.
 #![warn(missing_docs)]
 
 pub mod bench;

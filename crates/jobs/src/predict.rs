@@ -64,7 +64,7 @@ pub fn in_dataset_units<'m>(
     Ok(std::borrow::Cow::Owned(m))
 }
 
-/// Predicts every trajectory of `ds` with the PR-SSM (in parallel with feature `parallel`;
+/// Predicts every trajectory of `ds` with the PR-SSM (in parallel on the caller's rayon pool;
 /// results do not depend on threading): output means (N, N·mm) and variances, row-major
 /// `n × 5`; latent means and variances (standardized), `n × D_x`. `progress.advance(1)` per
 /// trajectory.

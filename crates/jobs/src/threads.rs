@@ -7,8 +7,8 @@
 
 use crate::error::{JobError, Result};
 
-/// Runs `job` on a pool of `threads` threads (`None`: the global pool). Without the `parallel`
-/// feature every job runs on the calling thread.
+/// Runs `job` on a pool of `threads` threads (`None`: the global pool); `Some(1)` runs every
+/// parallel loop of the job on one thread.
 ///
 /// # Errors
 /// [`JobError::Setting`] for `Some(0)` or a pool that cannot be built.
@@ -26,34 +26,20 @@ pub fn run_with_threads<T: Send>(
             expected: "must be at least 1".into(),
         });
     }
-    #[cfg(feature = "parallel")]
-    {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(n)
-            .build()
-            .map_err(|e| JobError::Setting {
-                name: "threads".into(),
-                value: n.to_string(),
-                expected: format!("a pool of that size could not be started: {e}"),
-            })?;
-        Ok(pool.install(job))
-    }
-    #[cfg(not(feature = "parallel"))]
-    {
-        Ok(job())
-    }
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(n)
+        .build()
+        .map_err(|e| JobError::Setting {
+            name: "threads".into(),
+            value: n.to_string(),
+            expected: format!("a pool of that size could not be started: {e}"),
+        })?;
+    Ok(pool.install(job))
 }
 
-/// Threads of the pool the caller runs on (1 without the `parallel` feature).
+/// Threads of the pool the caller runs on.
 pub fn current_threads() -> usize {
-    #[cfg(feature = "parallel")]
-    {
-        rayon::current_num_threads()
-    }
-    #[cfg(not(feature = "parallel"))]
-    {
-        1
-    }
+    rayon::current_num_threads()
 }
 
 #[cfg(test)]
@@ -64,7 +50,7 @@ mod tests {
     fn the_job_runs_on_a_pool_of_the_requested_size() {
         for n in [1, 3] {
             let seen = run_with_threads(Some(n), current_threads).unwrap();
-            assert_eq!(seen, if cfg!(feature = "parallel") { n } else { 1 });
+            assert_eq!(seen, n);
         }
         assert!(run_with_threads(Some(0), || ()).is_err());
         assert_eq!(run_with_threads(None, || 7).unwrap(), 7);

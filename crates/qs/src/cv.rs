@@ -401,15 +401,10 @@ fn standardize(
     })
 }
 
-#[cfg(feature = "parallel")]
+/// `f(0), …, f(n − 1)` on the caller's rayon pool, in index order.
 fn par_map<T: Send>(n: usize, f: impl Fn(usize) -> T + Sync + Send) -> Vec<T> {
     use rayon::prelude::*;
     (0..n).into_par_iter().map(f).collect()
-}
-
-#[cfg(not(feature = "parallel"))]
-fn par_map<T: Send>(n: usize, f: impl Fn(usize) -> T + Sync + Send) -> Vec<T> {
-    (0..n).map(f).collect()
 }
 
 fn check_columns(c: &Columns, kind: &'static str) -> Result<usize, QsError> {

@@ -8,7 +8,7 @@
 //! the pitch axis, r_s = r0). The sensor chain ([`crate::sensor`]) adds the experiment's errors,
 //! low-passes and decimates to the dataset rate (25 Hz). Inputs are the 7 inputs at the dataset
 //! rate, from encoder-quantized, Savitzky–Golay-differentiated angles (or the analytic ones
-//! when `sensor.encoder` is off). Trajectories run in parallel (feature `parallel`); trajectory i uses
+//! when `sensor.encoder` is off). Trajectories run in parallel (rayon); trajectory i uses
 //! ChaCha8 stream i of the seed, so results do not depend on threading.
 
 use crate::aero::blade_element::{AeroError, BladeElement, BladeGeometry};
@@ -24,6 +24,7 @@ use crate::trajectories::{GeneratorConfig, TrajectoryError, TrajectorySpec};
 use crate::vortex::{StripLdvmFactory, StripLdvmParams, VortexError};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
@@ -412,7 +413,7 @@ fn add(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
 const SENSOR_SEED_SALT: u64 = 0x5e45_0f0a_11ce_d00d;
 
 /// Simulates a whole dataset: generates the trajectories of `cfg.trajectories`, runs the wing
-/// on each (in parallel with feature `parallel`; `progress` is called once per finished
+/// on each (in parallel on the caller's rayon pool; `progress` is called once per finished
 /// trajectory) and assembles the [`Dataset`] with generator `"flapssm simulate"` and settings
 /// {fidelity, the whole `SimulationConfig`, the per-dataset sensor errors, mean Re}.
 pub fn simulate_dataset(
@@ -440,24 +441,11 @@ pub fn simulate_dataset(
         progress();
         t
     };
-    #[cfg(feature = "parallel")]
-    let trajectories: Result<Vec<Trajectory>, SimulateError> = {
-        use rayon::prelude::*;
-        specs
-            .par_iter()
-            .enumerate()
-            .map_init(|| VirtualWing::new(&cfg.wing), run_one)
-            .collect()
-    };
-    #[cfg(not(feature = "parallel"))]
-    let trajectories: Result<Vec<Trajectory>, SimulateError> = {
-        let mut wing = VirtualWing::new(&cfg.wing);
-        specs
-            .iter()
-            .enumerate()
-            .map(|x| run_one(&mut wing, x))
-            .collect()
-    };
+    let trajectories: Result<Vec<Trajectory>, SimulateError> = specs
+        .par_iter()
+        .enumerate()
+        .map_init(|| VirtualWing::new(&cfg.wing), run_one)
+        .collect();
     let trajectories = trajectories?;
     let n = trajectories.len().max(1) as f64;
     let mean_u_ref = trajectories.iter().map(|t| t.u_ref_m_s).sum::<f64>() / n;

@@ -325,7 +325,7 @@ pub(super) fn html_report(
     }
 }
 
-/// Versions of the flapssm crates used.
+/// Versions of the flapssm crates used, the build and the threads of the pool it ran on.
 pub fn versions() -> Vec<(String, String)> {
     vec![
         ("flapssm".into(), env!("CARGO_PKG_VERSION").into()),
@@ -339,13 +339,8 @@ pub fn versions() -> Vec<(String, String)> {
             .into(),
         ),
         (
-            "parallel".into(),
-            if cfg!(feature = "parallel") {
-                "rayon"
-            } else {
-                "off"
-            }
-            .into(),
+            "threads".into(),
+            crate::threads::current_threads().to_string(),
         ),
     ]
 }

@@ -12,6 +12,7 @@
 
 use flapssm_prssm::train::EpochRecord;
 use flapssm_wing::dataset::{Dataset, Trajectory};
+use rayon::prelude::*;
 
 use crate::error::{JobError, Result};
 use crate::progress::Progress;
@@ -88,7 +89,7 @@ pub struct ModelPrediction {
     pub latent_mean: Vec<f64>,
 }
 
-/// Predicts every trajectory of `ds` with `model` (in parallel with feature `parallel`;
+/// Predicts every trajectory of `ds` with `model` (in parallel on the caller's rayon pool;
 /// results do not depend on threading). `progress.advance(1)` per trajectory.
 ///
 /// # Errors
@@ -119,8 +120,8 @@ pub fn predict_all(
     })
 }
 
-/// `f(i, trajectory)` for every trajectory of `ds`, in parallel with feature `parallel` (on the
-/// caller's pool), results in trajectory order; the first error wins.
+/// `f(i, trajectory)` for every trajectory of `ds`, in parallel on the caller's rayon pool,
+/// results in trajectory order; the first error wins.
 ///
 /// # Errors
 /// The first trajectory's error.
@@ -128,23 +129,11 @@ pub fn map_trajectories<T: Send>(
     ds: &Dataset,
     f: impl Fn(usize, &Trajectory) -> Result<T> + Sync,
 ) -> Result<Vec<T>> {
-    #[cfg(feature = "parallel")]
-    {
-        use rayon::prelude::*;
-        ds.trajectories
-            .par_iter()
-            .enumerate()
-            .map(|(i, t)| f(i, t))
-            .collect()
-    }
-    #[cfg(not(feature = "parallel"))]
-    {
-        ds.trajectories
-            .iter()
-            .enumerate()
-            .map(|(i, t)| f(i, t))
-            .collect()
-    }
+    ds.trajectories
+        .par_iter()
+        .enumerate()
+        .map(|(i, t)| f(i, t))
+        .collect()
 }
 
 /// Checks that `buffer` holds `n × width` values.

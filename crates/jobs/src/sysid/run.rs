@@ -1,6 +1,7 @@
 //! The protocol's run: restarts per seed fitted in parallel, the test part predicted open loop,
 //! the restarts combined and scored.
 
+use rayon::prelude::*;
 use std::time::Instant;
 
 use flapssm_prssm::predict::Prediction;
@@ -192,17 +193,8 @@ pub fn run(
                 last,
             })
         };
-        let fits: Vec<Result<Restart, FitError>> = {
-            #[cfg(feature = "parallel")]
-            {
-                use rayon::prelude::*;
-                (0..spec.restarts).into_par_iter().map(one).collect()
-            }
-            #[cfg(not(feature = "parallel"))]
-            {
-                (0..spec.restarts).map(one).collect()
-            }
-        };
+        let fits: Vec<Result<Restart, FitError>> =
+            (0..spec.restarts).into_par_iter().map(one).collect();
         let fits = fits
             .into_iter()
             .collect::<Result<Vec<_>, _>>()

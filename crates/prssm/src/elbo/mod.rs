@@ -18,6 +18,7 @@
 //! ([`crate::conditional::tape_len`] values per step); beyond [`TAPE_BUDGET_BYTES`] per chunk, earlier
 //! segments are recomputed from the stored states and draws.
 
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::conditional::{ConditionalGrads, ConditionalWorkspace, Posterior};
@@ -442,13 +443,7 @@ impl Elbo {
             })
             .collect();
         let run = |c: &Vec<usize>| self.run_chunk(&post, &p, batch, c, init, seed, lik_scale);
-        #[cfg(feature = "parallel")]
-        let outs: Vec<ChunkOut> = {
-            use rayon::prelude::*;
-            chunks.par_iter().map(run).collect()
-        };
-        #[cfg(not(feature = "parallel"))]
-        let outs: Vec<ChunkOut> = chunks.iter().map(run).collect();
+        let outs: Vec<ChunkOut> = chunks.par_iter().map(run).collect();
 
         let mut nll = 0.0;
         let mut cond = ConditionalGrads::zeros(&post);

@@ -19,6 +19,7 @@
 //! averaged over output channels, over the steps after the burn-in, on at most
 //! `eval_max_sequences` training sequences and all validation sequences.
 
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use super::batches::{BatchPlan, WindowSpec, derive_seed};
@@ -371,13 +372,8 @@ pub fn fit(
             )
             .map_err(|e| format!("sequence {i}: {e}"))
         };
-        #[cfg(feature = "parallel")]
-        let preds: Vec<Result<Prediction, String>> = {
-            use rayon::prelude::*;
-            set.par_iter().enumerate().map(rollout).collect()
-        };
-        #[cfg(not(feature = "parallel"))]
-        let preds: Vec<Result<Prediction, String>> = set.iter().enumerate().map(rollout).collect();
+        let preds: Vec<Result<Prediction, String>> =
+            set.par_iter().enumerate().map(rollout).collect();
         let (mut s2, mut n) = (0.0, 0.0);
         for (seq, pred) in set.iter().zip(preds) {
             let pred = pred?;

@@ -31,6 +31,7 @@ use crate::dataset::{DatasetMeta, FORMAT_VERSION, Fluid, INPUT_UNITS, OUTPUT_UNI
 use crate::kinematics::{EulerState, WingKinematics};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 use thiserror::Error;
@@ -390,15 +391,7 @@ impl GeneratorConfig {
         self.check()?;
         let families = self.family_sequence();
         let one = |(i, fam): (usize, &Family)| self.generate_one(i, *fam);
-        #[cfg(feature = "parallel")]
-        {
-            use rayon::prelude::*;
-            families.par_iter().enumerate().map(one).collect()
-        }
-        #[cfg(not(feature = "parallel"))]
-        {
-            families.iter().enumerate().map(one).collect()
-        }
+        families.par_iter().enumerate().map(one).collect()
     }
 
     /// Generates trajectory `index` of family `family` (deterministic in `seed` and `index`).
