@@ -225,7 +225,7 @@ fn bad_dataset_files() {
         &out,
     );
 
-    let meta = Dataset::load(&imported(d)).unwrap().meta;
+    let meta = Dataset::load(&imported(d)).unwrap().into_inner().meta;
     let mut json = serde_json::to_value(&meta).unwrap();
     json["format_version"] = serde_json::json!(2);
     let p = npz_with(

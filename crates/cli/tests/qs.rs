@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 use common::flapssm;
 
 use flapssm_data::npz::NpzReader;
-use flapssm_wing::dataset::{Dataset, DatasetMeta, Trajectory};
+use flapssm_wing::dataset::{Dataset, DatasetMeta, Trajectory, ValidDataset};
 use flapssm_wing::features::published_features;
 
 fn reference() -> PathBuf {
@@ -172,7 +172,10 @@ fn fit_and_predict_a_dataset() {
     let dir = tempfile::tempdir().unwrap();
     let ds_path = dir.path().join("ds.npz");
     let noise = 0.05;
-    dataset(24, 200, noise).save(&ds_path).unwrap();
+    ValidDataset::new(dataset(24, 200, noise))
+        .unwrap()
+        .save(&ds_path)
+        .unwrap();
     let model = dir.path().join("lrqsm.json");
     let out = flapssm(&[
         "qs",

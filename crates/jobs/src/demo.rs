@@ -24,7 +24,7 @@ use std::time::Instant;
 use flapssm_prssm::PrssmModel;
 use flapssm_prssm::train::{Checkpoint, LrSchedule};
 use flapssm_qs::{EnetOptions, LrqsmModel};
-use flapssm_wing::dataset::{Dataset, OUTPUT_NAMES};
+use flapssm_wing::dataset::{OUTPUT_NAMES, ValidDataset};
 use flapssm_wing::features::FeatureSet;
 use flapssm_wing::virtual_wing::{Fidelity, SimulationConfig};
 use serde::{Deserialize, Serialize};
@@ -467,8 +467,8 @@ pub fn run_demo(
     Ok(summary)
 }
 
-fn load_dataset(path: &Path) -> Result<Dataset> {
-    Dataset::load(path).map_err(|source| JobError::DatasetFile {
+fn load_dataset(path: &Path) -> Result<ValidDataset> {
+    flapssm_wing::dataset::Dataset::load(path).map_err(|source| JobError::DatasetFile {
         path: path.to_path_buf(),
         source,
     })

@@ -11,7 +11,7 @@ use flapssm_prssm::predict::Prediction;
 use flapssm_prssm::train::InitialStateSpec;
 use flapssm_prssm::train::fit::training_record;
 use flapssm_prssm::{PrssmModel, Sequence};
-use flapssm_wing::dataset::{Dataset, Trajectory};
+use flapssm_wing::dataset::{Trajectory, ValidDataset};
 
 use crate::error::{JobError, Result};
 use crate::models::map_trajectories;
@@ -41,7 +41,7 @@ pub fn trajectory_sequence(t: &Trajectory) -> Sequence {
 /// compute them from.
 pub fn in_dataset_units<'m>(
     model: &'m PrssmModel,
-    ds: &Dataset,
+    ds: &ValidDataset,
 ) -> Result<std::borrow::Cow<'m, PrssmModel>> {
     if model.normalization.is_some() {
         return Ok(std::borrow::Cow::Borrowed(model));
@@ -74,7 +74,7 @@ pub fn in_dataset_units<'m>(
 /// the trajectory.
 pub fn predict_prssm(
     model: &PrssmModel,
-    ds: &Dataset,
+    ds: &ValidDataset,
     particles: usize,
     seed: u64,
     progress: &dyn Progress,
@@ -110,7 +110,7 @@ pub struct DatasetPredictionSummary {
 /// and file errors naming the trajectory or file.
 pub fn predict_dataset_file(
     model: &PrssmModel,
-    ds: &Dataset,
+    ds: &ValidDataset,
     particles: usize,
     seed: u64,
     out: &Path,

@@ -2,7 +2,7 @@
 
 use std::path::Path;
 
-use flapssm_wing::dataset::Dataset;
+use flapssm_wing::dataset::ValidDataset;
 use flapssm_wing::sensor::SensorConfig;
 use flapssm_wing::trajectories::{GeneratorConfig, default_n_train};
 use flapssm_wing::virtual_wing::{Fidelity, SimulationConfig, VirtualWingConfig, simulate_dataset};
@@ -96,7 +96,7 @@ pub fn simulate(
     cfg: &SimulationConfig,
     out: Option<&Path>,
     progress: &dyn Progress,
-) -> Result<Dataset> {
+) -> Result<ValidDataset> {
     progress.start("simulate", cfg.trajectories.n_trajectories as u64);
     let ds = simulate_dataset(cfg, &|| progress.advance(1))?;
     if let Some(path) = out {

@@ -13,7 +13,7 @@ use std::time::Instant;
 
 use flapssm_prssm::train::EpochRecord;
 use flapssm_prssm::train::fit::FitSpec;
-use flapssm_wing::dataset::{Dataset, OUTPUT_NAMES};
+use flapssm_wing::dataset::{OUTPUT_NAMES, ValidDataset};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{JobError, Result};
@@ -92,7 +92,7 @@ pub struct SweepResult {
     pub kind: SweepKind,
     /// Its value.
     pub value: usize,
-    /// Dataset description.
+    /// ValidDataset description.
     pub dataset: String,
     /// Trajectories fitted (after the validation hold-out).
     pub n_fit: usize,
@@ -124,7 +124,7 @@ pub struct SweepResult {
 /// the training set or below 2), training and prediction errors.
 #[allow(clippy::too_many_arguments)]
 pub fn sweep_run(
-    ds: &Dataset,
+    ds: &ValidDataset,
     dataset_label: &str,
     kind: SweepKind,
     value: usize,
@@ -135,7 +135,6 @@ pub fn sweep_run(
     progress: &dyn Progress,
     stop: Option<&AtomicBool>,
 ) -> Result<SweepResult> {
-    ds.validate()?;
     let stats = ds.standardization()?;
     let n_train = ds.n_train.min(ds.len());
     let mut opts = opts.clone();
@@ -166,15 +165,7 @@ pub fn sweep_run(
     progress.finish("");
 
     progress.start("predict", ds.len() as u64);
-    let sub = Dataset {
-        trajectories: ds.trajectories[..used]
-            .iter()
-            .chain(&ds.trajectories[n_train..])
-            .cloned()
-            .collect(),
-        n_train: used,
-        ..ds.clone()
-    };
+    let sub = ds.with_training_prefix(used)?;
     let pred = predict_prssm(&out.best, &sub, particles, seed, progress)?;
     progress.finish("");
     let z = |y: &[f64]| -> Vec<f64> {

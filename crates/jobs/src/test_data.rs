@@ -1,11 +1,11 @@
 //! Small seeded data shared by the unit tests of the jobs.
 
 use flapssm_prssm::{ModelConfig, Params, PrssmModel};
-use flapssm_wing::dataset::Dataset;
+use flapssm_wing::dataset::ValidDataset;
 use flapssm_wing::virtual_wing::{SimulationConfig, simulate_dataset};
 
 /// Six simulated trajectories (four training), seed 3.
-pub(crate) fn tiny_dataset() -> Dataset {
+pub(crate) fn tiny_dataset() -> ValidDataset {
     let mut cfg = SimulationConfig::default();
     cfg.trajectories.n_trajectories = 6;
     cfg.trajectories.n_train = 4;

@@ -7,7 +7,7 @@ use std::sync::atomic::AtomicBool;
 use flapssm_prssm::Sequence;
 use flapssm_prssm::train::fit::{FitError, FitOutcome, FitSpec, Preset, fit};
 use flapssm_prssm::train::{Budget, Checkpoint, LrSchedule, TrainEvent, TrainHooks};
-use flapssm_wing::dataset::{Dataset, Trajectory};
+use flapssm_wing::dataset::{Trajectory, ValidDataset};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{JobError, Result};
@@ -362,7 +362,7 @@ pub struct TrainSummary {
 /// [`JobError::Dataset`] for a dataset without outputs or training trajectories, checkpoint and
 /// model-file errors naming the file, [`JobError::Interrupted`] when stopped.
 pub fn train_dataset(
-    ds: &Dataset,
+    ds: &ValidDataset,
     plan: &TrainingPlan,
     files: &TrainFiles,
     resume: bool,

@@ -1,4 +1,4 @@
-//! The LRQSM on a flapssm [`Dataset`]: fit on the training trajectories, predict all.
+//! The LRQSM on a flapssm dataset ([`ValidDataset`]): fit on the training trajectories, predict all.
 //!
 //! Rows are the samples of the trajectories in order (trajectory-major), so contiguous CV
 //! folds hold whole trajectories up to the fold boundaries. Features are those of a
@@ -8,7 +8,7 @@
 use std::path::Path;
 
 use flapssm_data::npz::{NpyData, NpzWriter};
-use flapssm_wing::dataset::{Dataset, OUTPUT_NAMES, Trajectory};
+use flapssm_wing::dataset::{OUTPUT_NAMES, Trajectory, ValidDataset};
 use flapssm_wing::features::FeatureSet;
 
 use crate::cv::{Columns, EnetOptions, fit_enet_cv};
@@ -33,14 +33,13 @@ pub fn trajectory_features(trajectories: &[Trajectory], set: FeatureSet) -> Vec<
 /// with the training statistics. `source` names the dataset in the model file.
 ///
 /// # Errors
-/// An invalid dataset (or one without outputs), and every error of [`fit_enet_cv`].
+/// A dataset without outputs, and every error of [`fit_enet_cv`].
 pub fn fit_dataset(
-    ds: &Dataset,
+    ds: &ValidDataset,
     set: FeatureSet,
     opts: &EnetOptions,
     source: &str,
 ) -> Result<LrqsmModel, QsError> {
-    ds.validate()?;
     let stats = ds.standardization()?;
     let train = ds.train();
     let x = trajectory_features(train, set);
@@ -114,13 +113,12 @@ pub struct DatasetPrediction {
 ///
 /// # Errors
 /// [`QsError::Mismatch`] for a model without a wing feature set or output scaling, or whose
-/// outputs are not the dataset's; an invalid dataset.
+/// outputs are not the dataset's.
 pub fn predict_dataset(
     model: &LrqsmModel,
-    ds: &Dataset,
+    ds: &ValidDataset,
     mode: InterceptMode,
 ) -> Result<DatasetPrediction, QsError> {
-    ds.validate()?;
     let (Some(set), Some(scaling)) = (model.feature_set, &model.target_scaling) else {
         return Err(QsError::Mismatch(
             "the model was fitted on custom columns (fit-csv), not on a dataset's wing features"

@@ -1,11 +1,11 @@
 //! Save/load time of a dataset file of the published size (548 trajectories × 470 samples).
 
 use criterion::{Criterion, black_box, criterion_group, criterion_main};
-use flapssm_wing::dataset::{Dataset, DatasetMeta, Trajectory};
+use flapssm_wing::dataset::{Dataset, DatasetMeta, Trajectory, ValidDataset};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-fn published_size() -> Dataset {
+fn published_size() -> ValidDataset {
     let mut rng = ChaCha8Rng::seed_from_u64(1);
     let trajectories = (0..548)
         .map(|_| Trajectory {
@@ -24,12 +24,13 @@ fn published_size() -> Dataset {
             family: "measured".into(),
         })
         .collect();
-    Dataset {
+    ValidDataset::new(Dataset {
         meta: DatasetMeta::new("bench", Some(1), serde_json::Value::Null),
         dt_s: 0.04,
         trajectories,
         n_train: 512,
-    }
+    })
+    .unwrap()
 }
 
 fn bench(c: &mut Criterion) {

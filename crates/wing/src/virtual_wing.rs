@@ -16,7 +16,7 @@ use crate::aero::unsteady::UnsteadyParams;
 use crate::aero::{SectionGeometry, SectionModelFactory};
 use crate::check::first_not_positive;
 use crate::cycles::{self, CycleError};
-use crate::dataset::{Dataset, Trajectory};
+use crate::dataset::{Dataset, Trajectory, ValidDataset};
 use crate::dataset::{DatasetMeta, FORMAT_VERSION, Fluid, INPUT_UNITS, OUTPUT_UNITS, WingGeometry};
 use crate::kinematics::{EulerState, WingKinematics, rotation_global_from_wing};
 use crate::sensor::{DatasetSensorErrors, SensorConfig, measure};
@@ -112,6 +112,9 @@ pub enum SimulateError {
         /// Raw sample index.
         sample: usize,
     },
+    /// The assembled dataset failed [`Dataset::validate`].
+    #[error("the simulated dataset is invalid: {0}")]
+    Invalid(#[from] crate::dataset::DatasetError),
 }
 
 /// The virtual wing: geometry, fluid, fidelity, aerodynamic and sensor parameters.
@@ -415,11 +418,12 @@ const SENSOR_SEED_SALT: u64 = 0x5e45_0f0a_11ce_d00d;
 /// Simulates a whole dataset: generates the trajectories of `cfg.trajectories`, runs the wing
 /// on each (in parallel on the caller's rayon pool; `progress` is called once per finished
 /// trajectory) and assembles the [`Dataset`] with generator `"flapssm simulate"` and settings
-/// {fidelity, the whole `SimulationConfig`, the per-dataset sensor errors, mean Re}.
+/// {fidelity, the whole `SimulationConfig`, the per-dataset sensor errors, mean Re}, checked once
+/// ([`ValidDataset`]).
 pub fn simulate_dataset(
     cfg: &SimulationConfig,
     progress: &(dyn Fn() + Sync),
-) -> Result<Dataset, SimulateError> {
+) -> Result<ValidDataset, SimulateError> {
     cfg.wing.check()?;
     cfg.wing.factory()?;
     let specs = cfg.trajectories.generate()?;
@@ -457,7 +461,7 @@ pub fn simulate_dataset(
         "mean_u_ref_m_s": mean_u_ref,
         "mean_reynolds_number": reynolds,
     });
-    Ok(Dataset {
+    let ds = Dataset {
         meta: DatasetMeta {
             format_version: FORMAT_VERSION,
             wing: cfg.wing.wing.clone(),
@@ -471,7 +475,8 @@ pub fn simulate_dataset(
         dt_s: sampling.dataset_dt_s(),
         trajectories,
         n_train: cfg.trajectories.n_train,
-    })
+    };
+    Ok(ValidDataset::new(ds)?)
 }
 
 #[cfg(test)]

@@ -82,7 +82,7 @@ fn dataset(fidelity: Fidelity, flat: bool, chordwise: Chordwise) -> (Dataset, Ve
         wing.aero.quasi_steady.added_mass_chordwise = false;
     }
     let cfg = SimulationConfig { wing, trajectories };
-    (simulate_dataset(&cfg, &|| {}).unwrap(), freqs)
+    (simulate_dataset(&cfg, &|| {}).unwrap().into_inner(), freqs)
 }
 
 /// Regressor rows. QS: [1, 11 features(t)]. History: [1, 11 features(t), 7 inputs(t)] and, at

@@ -545,7 +545,7 @@ fn noise_free_dataset(
     n: usize,
     n_train: usize,
     seed: u64,
-) -> flapssm_wing::dataset::Dataset {
+) -> flapssm_wing::dataset::ValidDataset {
     use flapssm_wing::sensor::SensorConfig;
     use flapssm_wing::trajectories::GeneratorConfig;
     use flapssm_wing::virtual_wing::{SimulationConfig, simulate_dataset};

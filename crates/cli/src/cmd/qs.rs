@@ -11,7 +11,7 @@ use flapssm_qs::cv::{EnetOptions, FoldLayout, LambdaRule};
 use flapssm_qs::lrqsm::Rmse;
 use flapssm_qs::table::{fit_table, read_csv};
 use flapssm_qs::{InterceptMode, LrqsmModel};
-use flapssm_wing::dataset::Dataset;
+use flapssm_wing::dataset::{Dataset, ValidDataset};
 use flapssm_wing::features::FeatureSet;
 
 /// Quasi-steady baseline subcommands.
@@ -160,7 +160,7 @@ pub fn run(cmd: QsCommand) -> Result<()> {
     }
 }
 
-fn load_dataset(path: &Path) -> Result<Dataset> {
+fn load_dataset(path: &Path) -> Result<ValidDataset> {
     Dataset::load(path).with_context(|| format!("cannot load dataset {}", path.display()))
 }
 

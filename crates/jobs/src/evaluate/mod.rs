@@ -6,7 +6,7 @@
 //!   latent states (the PR-SSM: standardized latent units, `n × D_x`, particle draws seeded by
 //!   [`crate::seed::prediction_seed`]`(seed, i)`).
 //! - Standardized errors `e = (y − ŷ)/σ_y` with the dataset's training statistics
-//!   ([`Dataset::standardization`]), pooled from `start_sample` on (published: the first 93
+//!   ([`ValidDataset::standardization`]), pooled from `start_sample` on (published: the first 93
 //!   samples dropped): per-output RMSE, overall `√mean(e²)`, 2.5/97.5 % intervals.
 //! - Coefficients `C_F = F/(½ρSU_ref²)`, `C_M = M/(½ρc̄SU_ref²·1000)` per trajectory; the last
 //!   full cycle from [`flapssm_wing::cycles::published_window`]; per-trajectory C_Fx/C_Fy RMSE
@@ -21,7 +21,7 @@
 use std::path::{Path, PathBuf};
 
 use flapssm_wing::cycles::published_window;
-use flapssm_wing::dataset::{Dataset, OUTPUT_NAMES};
+use flapssm_wing::dataset::{OUTPUT_NAMES, ValidDataset};
 use serde::{Deserialize, Serialize};
 
 use flapssm_analysis::authority::{
@@ -231,7 +231,7 @@ pub struct AuthorityFinding {
 pub struct EvaluationReport {
     /// [`METRICS_VERSION`].
     pub version: u32,
-    /// Dataset description (file name or origin).
+    /// ValidDataset description (file name or origin).
     pub dataset: String,
     /// Training trajectories.
     pub n_train: usize,
@@ -286,7 +286,7 @@ pub struct ReportContext {
 /// trajectories without a full stroke cycle, analysis and I/O errors — each naming its item.
 #[allow(clippy::too_many_arguments)]
 pub fn evaluate(
-    ds: &Dataset,
+    ds: &ValidDataset,
     dataset_label: &str,
     models: &[&dyn LoadModel],
     opts: &EvalOptions,
@@ -388,9 +388,8 @@ pub fn evaluate(
 }
 
 /// Checks the inputs once, before any prediction.
-fn check(ds: &Dataset, models: &[&dyn LoadModel], opts: &EvalOptions) -> Result<()> {
+fn check(ds: &ValidDataset, models: &[&dyn LoadModel], opts: &EvalOptions) -> Result<()> {
     opts.check()?;
-    ds.validate()?;
     if !ds.has_outputs() {
         return Err(flapssm_wing::dataset::DatasetError::NoOutputs.into());
     }
@@ -418,7 +417,7 @@ fn check(ds: &Dataset, models: &[&dyn LoadModel], opts: &EvalOptions) -> Result<
 
 /// Each trajectory's window and its measured and predicted tables (standardized and as
 /// coefficients).
-fn prepare(ds: &Dataset, predictions: &[Vec<ModelPrediction>]) -> Result<Vec<Prepared>> {
+fn prepare(ds: &ValidDataset, predictions: &[Vec<ModelPrediction>]) -> Result<Vec<Prepared>> {
     let stats = ds.standardization()?;
     let (fluid, wing) = (&ds.meta.fluid, &ds.meta.wing);
     let z = |y: &[f64]| -> Vec<f64> {
@@ -520,7 +519,7 @@ fn model_metrics(
 }
 
 fn trajectory_metrics(
-    ds: &Dataset,
+    ds: &ValidDataset,
     models: &[&dyn LoadModel],
     prep: &[Prepared],
     n_train: usize,
@@ -594,7 +593,7 @@ impl Authority {
 
 /// Control authority on the latent means, every trajectory, transient dropped.
 fn authority(
-    ds: &Dataset,
+    ds: &ValidDataset,
     predictions: &[ModelPrediction],
     dx: usize,
     prep: &[Prepared],
@@ -651,7 +650,7 @@ fn authority(
 /// Draws every figure; `file` names (and records) each file.
 #[allow(clippy::too_many_arguments)]
 fn draw_figures(
-    ds: &Dataset,
+    ds: &ValidDataset,
     models: &[&dyn LoadModel],
     prep: &[Prepared],
     sets: &Sets<'_>,

@@ -15,7 +15,7 @@
 
 use faer::linalg::solvers::Solve;
 use faer::{Mat, Side};
-use flapssm_wing::dataset::{Dataset, Trajectory};
+use flapssm_wing::dataset::{Trajectory, ValidDataset};
 use serde::{Deserialize, Serialize};
 
 use super::{Fit, LoadModel, LoadPrediction, check_buffer};
@@ -126,7 +126,7 @@ impl ArxModel {
 impl Fit for ArxFit {
     type Model = ArxModel;
 
-    fn fit(&self, ds: &Dataset, progress: &dyn Progress) -> Result<ArxModel> {
+    fn fit(&self, ds: &ValidDataset, progress: &dyn Progress) -> Result<ArxModel> {
         progress.start("fit ARX", 0);
         let stats = ds.standardization()?;
         let mut model = ArxModel {
@@ -229,7 +229,7 @@ mod tests {
     use crate::progress::NoProgress;
     use flapssm_wing::virtual_wing::{SimulationConfig, simulate_dataset};
 
-    fn dataset() -> Dataset {
+    fn dataset() -> ValidDataset {
         let mut cfg = SimulationConfig::default();
         cfg.trajectories.n_trajectories = 5;
         cfg.trajectories.n_train = 4;
@@ -242,7 +242,7 @@ mod tests {
     /// first sample at their training mean, as the model takes them).
     #[test]
     fn recovers_a_known_fir_system() {
-        let mut ds = dataset();
+        let mut ds = dataset().into_inner();
         let mean_u = ds.standardization().unwrap().mean_u;
         for t in &mut ds.trajectories {
             let u = t.inputs.clone();
@@ -264,6 +264,7 @@ mod tests {
         }
         .check()
         .unwrap();
+        let ds = ValidDataset::new(ds).unwrap();
         let m = fit.fit(&ds, &NoProgress).unwrap();
         let t = &ds.trajectories[4];
         let n = t.inputs.len();

@@ -6,7 +6,7 @@ use std::path::Path;
 
 use flapssm_qs::lrqsm::{DatasetPrediction, fit_dataset, predict_dataset, trajectory_features};
 use flapssm_qs::{EnetOptions, InterceptMode, LrqsmModel};
-use flapssm_wing::dataset::{Dataset, OUTPUT_NAMES, Trajectory};
+use flapssm_wing::dataset::{OUTPUT_NAMES, Trajectory, ValidDataset};
 use flapssm_wing::features::FeatureSet;
 
 use super::{Fit, LoadModel, LoadPrediction, check_buffer};
@@ -113,7 +113,7 @@ impl LoadModel for LrqsmLoadModel<'_> {
 /// [`JobError::Qs`] for a model that does not fit the dataset or a file that cannot be written.
 pub fn predict_file(
     model: &LrqsmModel,
-    ds: &Dataset,
+    ds: &ValidDataset,
     mode: InterceptMode,
     out: &Path,
 ) -> Result<DatasetPrediction> {
@@ -136,7 +136,7 @@ pub struct LrqsmFit {
 impl Fit for LrqsmFit {
     type Model = LrqsmLoadModel<'static>;
 
-    fn fit(&self, ds: &Dataset, progress: &dyn Progress) -> Result<Self::Model> {
+    fn fit(&self, ds: &ValidDataset, progress: &dyn Progress) -> Result<Self::Model> {
         progress.start("fit LRQSM", 0);
         let m = fit_dataset(ds, self.features, &self.options, &self.source)?;
         progress.finish("");

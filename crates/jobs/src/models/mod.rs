@@ -11,7 +11,7 @@
 //! | ARX | [`arx`] | least squares on lagged inputs |
 
 use flapssm_prssm::train::EpochRecord;
-use flapssm_wing::dataset::{Dataset, Trajectory};
+use flapssm_wing::dataset::{Trajectory, ValidDataset};
 use rayon::prelude::*;
 
 use crate::error::{JobError, Result};
@@ -75,7 +75,7 @@ pub trait Fit {
     ///
     /// # Errors
     /// The model's fitting errors, naming the dataset or trajectory.
-    fn fit(&self, ds: &Dataset, progress: &dyn Progress) -> Result<Self::Model>;
+    fn fit(&self, ds: &ValidDataset, progress: &dyn Progress) -> Result<Self::Model>;
 }
 
 /// One model's open-loop prediction of one trajectory (owned tables of [`LoadPrediction`]).
@@ -96,7 +96,7 @@ pub struct ModelPrediction {
 /// The first trajectory's error.
 pub fn predict_all(
     model: &dyn LoadModel,
-    ds: &Dataset,
+    ds: &ValidDataset,
     progress: &dyn Progress,
 ) -> Result<Vec<ModelPrediction>> {
     map_trajectories(ds, |i, t| {
@@ -126,7 +126,7 @@ pub fn predict_all(
 /// # Errors
 /// The first trajectory's error.
 pub fn map_trajectories<T: Send>(
-    ds: &Dataset,
+    ds: &ValidDataset,
     f: impl Fn(usize, &Trajectory) -> Result<T> + Sync,
 ) -> Result<Vec<T>> {
     ds.trajectories

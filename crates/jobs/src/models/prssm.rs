@@ -7,7 +7,7 @@ use flapssm_prssm::PrssmModel;
 use flapssm_prssm::predict::Prediction;
 use flapssm_prssm::train::EpochRecord;
 use flapssm_prssm::train::fit::{predict_raw, training_record};
-use flapssm_wing::dataset::{Dataset, Trajectory};
+use flapssm_wing::dataset::{Trajectory, ValidDataset};
 
 use super::{Fit, LoadModel, LoadPrediction, check_buffer};
 use crate::error::{JobError, Result};
@@ -32,7 +32,12 @@ impl<'m> PrssmLoadModel<'m> {
     /// # Errors
     /// [`JobError::Mismatch`] for a model that is not 7 inputs → 5 outputs or no particles;
     /// [`JobError::Dataset`] when the model has no statistics and `ds` none to offer.
-    pub fn new(model: &'m PrssmModel, ds: &Dataset, particles: usize, seed: u64) -> Result<Self> {
+    pub fn new(
+        model: &'m PrssmModel,
+        ds: &ValidDataset,
+        particles: usize,
+        seed: u64,
+    ) -> Result<Self> {
         let c = &model.config;
         if c.n_input != 7 || c.n_output != 5 {
             return Err(JobError::Mismatch {
@@ -161,7 +166,7 @@ pub struct PrssmFit {
 impl Fit for PrssmFit {
     type Model = PrssmLoadModel<'static>;
 
-    fn fit(&self, ds: &Dataset, progress: &dyn Progress) -> Result<Self::Model> {
+    fn fit(&self, ds: &ValidDataset, progress: &dyn Progress) -> Result<Self::Model> {
         let out = train_prssm(ds.train(), &self.plan, None, None, progress, None)?;
         Ok(PrssmLoadModel::new(&out.best, ds, self.particles, self.seed)?.into_owned())
     }

@@ -20,7 +20,7 @@ use std::path::{Path, PathBuf};
 
 use crate::dataset::{
     Dataset, DatasetError, DatasetMeta, EULER_NAMES, FORMAT_VERSION, INPUT_NAMES, OUTPUT_NAMES,
-    Trajectory,
+    Trajectory, ValidDataset,
 };
 use flapssm_data::atomic::write_atomic;
 use flapssm_data::table::split_csv_line;
@@ -103,17 +103,12 @@ fn quote(s: &str) -> String {
     }
 }
 
-impl Dataset {
+impl ValidDataset {
     /// Writes the dataset as long-format CSV (see [`crate::dataset::csv`]) atomically to `path`.
     ///
     /// # Errors
-    /// [`CsvError::Invalid`] if [`Dataset::validate`] fails, [`CsvError::Io`] on I/O failure
-    /// (no file is left behind).
+    /// [`CsvError::Io`] on I/O failure (no file is left behind).
     pub fn export_csv(&self, path: &Path) -> Result<(), CsvError> {
-        self.validate().map_err(|error| CsvError::Invalid {
-            path: path.to_path_buf(),
-            error,
-        })?;
         let meta = serde_json::to_string(&self.meta).map_err(|e| CsvError::Metadata {
             path: path.to_path_buf(),
             message: e.to_string(),
@@ -145,13 +140,15 @@ impl Dataset {
             error,
         })
     }
+}
 
-    /// Reads a long-format dataset CSV written by [`Dataset::export_csv`] (or by hand in
+impl Dataset {
+    /// Reads a long-format dataset CSV written by [`ValidDataset::export_csv`] (or by hand in
     /// the same layout) and validates it.
     ///
     /// # Errors
     /// A [`CsvError`] naming the file, line and column at fault.
-    pub fn import_csv(path: &Path) -> Result<Dataset, CsvError> {
+    pub fn import_csv(path: &Path) -> Result<ValidDataset, CsvError> {
         let text = std::fs::read_to_string(path).map_err(|error| CsvError::Io {
             path: path.to_path_buf(),
             error,
@@ -204,7 +201,7 @@ impl CsvImport {
         }
     }
 
-    fn parse(&self, text: &str) -> Result<Dataset, CsvError> {
+    fn parse(&self, text: &str) -> Result<ValidDataset, CsvError> {
         let mut lines = text.lines().enumerate().map(|(k, l)| (k + 1, l));
         let mut dt_s = None;
         let mut meta = None;
@@ -385,11 +382,10 @@ impl CsvImport {
             trajectories,
             n_train,
         };
-        ds.validate().map_err(|error| CsvError::Invalid {
+        ValidDataset::new(ds).map_err(|error| CsvError::Invalid {
             path: self.path.clone(),
             error,
-        })?;
-        Ok(ds)
+        })
     }
 }
 
@@ -406,7 +402,10 @@ mod tests {
             let mut ds = sample(4, 6, 3, with_y);
             ds.trajectories[1].family = "a \"quoted\", family".into();
             ds.trajectories[2].inputs[3][1] = 0.1 + 0.2;
-            ds.export_csv(&p).unwrap();
+            ValidDataset::new(ds.clone())
+                .unwrap()
+                .export_csv(&p)
+                .unwrap();
             assert_eq!(Dataset::import_csv(&p).unwrap(), ds);
         }
     }
@@ -420,9 +419,12 @@ mod tests {
         assert!(split_csv_line("\"open").is_err());
     }
 
-    fn edited(dir: &Path, edit: impl Fn(&mut Vec<String>)) -> Result<Dataset, CsvError> {
+    fn edited(dir: &Path, edit: impl Fn(&mut Vec<String>)) -> Result<ValidDataset, CsvError> {
         let p = dir.join("e.csv");
-        sample(3, 4, 2, true).export_csv(&p).unwrap();
+        ValidDataset::new(sample(3, 4, 2, true))
+            .unwrap()
+            .export_csv(&p)
+            .unwrap();
         let mut lines: Vec<String> = std::fs::read_to_string(&p)
             .unwrap()
             .lines()

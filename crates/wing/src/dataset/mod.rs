@@ -19,17 +19,21 @@
 //! (rad), the 7 inputs, the 5 outputs, the sampling period, `U_ref` and a family label, plus
 //! metadata, a train/test split and standardization statistics computed on the training part
 //! only. Its files:
-//! - [`store`]: the dataset file (one self-describing `.npz`), [`Dataset::save`]/[`Dataset::load`].
+//! - [`store`]: the dataset file (one self-describing `.npz`), [`ValidDataset::save`]/[`Dataset::load`].
 //! - [`csv`]: long-format CSV export/import.
 //! - [`published`]: import of the published Bayiz & Cheng dataset layout from a `.mat` file.
 //! - [`summary`]: a printable overview ([`Dataset::summary`]).
+//!
+//! Every reader returns a [`ValidDataset`] ([`valid`]): checked once, where it enters.
 
 pub mod csv;
 pub mod published;
 pub mod store;
 pub mod summary;
+pub mod valid;
 
 pub use store::StoreError;
+pub use valid::ValidDataset;
 
 use serde::{Deserialize, Serialize};
 

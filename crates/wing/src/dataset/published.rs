@@ -15,7 +15,7 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::dataset::{Dataset, DatasetError, DatasetMeta, Trajectory};
+use crate::dataset::{Dataset, DatasetError, DatasetMeta, Trajectory, ValidDataset};
 use flapssm_data::mat::{MatError, MatFile};
 
 /// Sampling period of the published dataset (s).
@@ -82,7 +82,7 @@ pub fn import_published_mat(
     path: &Path,
     n_train: Option<usize>,
     mut u_ref: impl FnMut(&[[f64; 3]], f64) -> Result<f64, String>,
-) -> Result<Dataset, PublishedError> {
+) -> Result<ValidDataset, PublishedError> {
     let mut mat = MatFile::read(path)?;
     let shape_err = |variable, found: &[usize], expected: String| PublishedError::Shape {
         path: path.to_path_buf(),
@@ -150,11 +150,10 @@ pub fn import_published_mat(
         trajectories,
         n_train: n_train.unwrap_or(PUBLISHED_N_TRAIN),
     };
-    ds.validate().map_err(|error| PublishedError::Invalid {
+    ValidDataset::new(ds).map_err(|error| PublishedError::Invalid {
         path: path.to_path_buf(),
         error,
-    })?;
-    Ok(ds)
+    })
 }
 
 #[cfg(test)]

@@ -21,6 +21,7 @@ use std::path::{Path, PathBuf};
 
 use crate::dataset::{
     Dataset, DatasetError, DatasetMeta, FORMAT_VERSION, INPUT_NAMES, OUTPUT_NAMES, Trajectory,
+    ValidDataset,
 };
 use flapssm_data::npz::{NpyData, NpzError, NpzReader, NpzWriter};
 
@@ -105,20 +106,18 @@ fn flatten<const N: usize>(rows: impl Iterator<Item = [f64; N]>, cap: usize) -> 
     out
 }
 
-impl Dataset {
-    /// Validates the dataset and writes it atomically to `path` as one `.npz` (see
-    /// [`crate::dataset::store`] for the arrays). Statistics are those of the training part (ddof 0).
+impl ValidDataset {
+    /// Writes the dataset atomically to `path` as one `.npz` (see [`crate::dataset::store`] for
+    /// the arrays). Statistics are those of the training part (ddof 0).
     ///
     /// # Errors
-    /// [`StoreError::Invalid`] if [`Dataset::validate`] fails or the training part holds no
-    /// sample (the statistics need one); [`StoreError::Npz`] on I/O failure (no file is left
-    /// behind).
+    /// [`StoreError::Invalid`] if the training part holds no sample (the statistics need one);
+    /// [`StoreError::Npz`] on I/O failure (no file is left behind).
     pub fn save(&self, path: &Path) -> Result<(), StoreError> {
         let invalid = |error| StoreError::Invalid {
             path: path.to_path_buf(),
             error,
         };
-        self.validate().map_err(invalid)?;
         let (n, n_t) = (self.len(), self.n_samples());
         let (mean_u, std_u) = self
             .input_stats()
@@ -202,8 +201,10 @@ impl Dataset {
         w.compression(false).save(path)?;
         Ok(())
     }
+}
 
-    /// Loads and checks a dataset file written by [`Dataset::save`] (or by numpy in the same
+impl Dataset {
+    /// Loads and checks a dataset file written by [`ValidDataset::save`] (or by numpy in the same
     /// layout): every array present with the right shape, all values finite, names as
     /// expected, `is_train` a prefix, statistics consistent with the data, known format version.
     ///
@@ -211,7 +212,7 @@ impl Dataset {
     ///
     /// # Errors
     /// A [`StoreError`] naming the file and the array at fault.
-    pub fn load(path: &Path) -> Result<Dataset, StoreError> {
+    pub fn load(path: &Path) -> Result<ValidDataset, StoreError> {
         Loader {
             path: path.to_path_buf(),
             r: NpzReader::open(path)?,
@@ -351,7 +352,7 @@ impl Loader {
         Ok(())
     }
 
-    fn load(mut self) -> Result<Dataset, StoreError> {
+    fn load(mut self) -> Result<ValidDataset, StoreError> {
         let meta = self.metadata()?;
         let dt_s = self.numeric("dt_s", &[])?;
         let euler = self.r.f64("euler_rad")?;
@@ -425,7 +426,7 @@ impl Loader {
         })?;
         self.check_stats(["mean_u", "std_u"], ds.input_stats())?;
         self.check_stats(["mean_y", "std_y"], ds.output_stats())?;
-        Ok(ds)
+        Ok(ValidDataset::validated(ds))
     }
 }
 
@@ -444,14 +445,14 @@ mod tests {
         for with_y in [true, false] {
             let path = dir.path().join(format!("d{with_y}.npz"));
             let ds = sample(5, 7, 3, with_y);
-            ds.save(&path).unwrap();
+            ValidDataset::new(ds.clone()).unwrap().save(&path).unwrap();
             assert_eq!(Dataset::load(&path).unwrap(), ds);
         }
     }
 
     /// Writes `ds` through the raw writer with one array replaced or removed.
     fn tampered(dir: &Path, name: &str, edit: impl FnOnce(&mut NpzWriter)) -> PathBuf {
-        let ds = sample(3, 4, 2, true);
+        let ds = ValidDataset::new(sample(3, 4, 2, true)).unwrap();
         let good = dir.join("good.npz");
         ds.save(&good).unwrap();
         let mut r = NpzReader::open(&good).unwrap();
@@ -530,7 +531,7 @@ mod tests {
     #[test]
     fn missing_array_is_named() {
         let dir = tmp();
-        let ds = sample(2, 3, 1, true);
+        let ds = ValidDataset::new(sample(2, 3, 1, true)).unwrap();
         let good = dir.path().join("good.npz");
         ds.save(&good).unwrap();
         let mut r = NpzReader::open(&good).unwrap();
@@ -557,7 +558,10 @@ mod tests {
     fn truncated_and_corrupt_files_are_errors() {
         let dir = tmp();
         let path = dir.path().join("d.npz");
-        sample(4, 50, 2, true).save(&path).unwrap();
+        ValidDataset::new(sample(4, 50, 2, true))
+            .unwrap()
+            .save(&path)
+            .unwrap();
         let bytes = std::fs::read(&path).unwrap();
         let cut = dir.path().join("cut.npz");
         std::fs::write(&cut, &bytes[..bytes.len() * 2 / 3]).unwrap();
@@ -603,13 +607,14 @@ mod tests {
         }
     }
 
+    /// Only a [`ValidDataset`] has `save`; an invalid one never becomes one.
     #[test]
-    fn invalid_dataset_is_not_saved() {
-        let dir = tmp();
-        let path = dir.path().join("x.npz");
+    fn invalid_dataset_cannot_be_saved() {
         let mut ds = sample(2, 3, 1, true);
         ds.trajectories[0].euler_rad[1][2] = f64::NAN;
-        assert!(matches!(ds.save(&path), Err(StoreError::Invalid { .. })));
-        assert!(!path.exists());
+        assert!(matches!(
+            ValidDataset::new(ds),
+            Err(DatasetError::NotFinite { .. })
+        ));
     }
 }

@@ -26,7 +26,7 @@
 //! (paper test trajectories #5 and #32).
 
 use crate::cycles::{self, CycleError, U_REF_RADIUS_M};
-use crate::dataset::{Dataset, Trajectory};
+use crate::dataset::{Dataset, DatasetError, Trajectory, ValidDataset};
 use crate::dataset::{DatasetMeta, FORMAT_VERSION, Fluid, INPUT_UNITS, OUTPUT_UNITS, WingGeometry};
 use crate::kinematics::{EulerState, WingKinematics};
 use rand::{Rng, SeedableRng};
@@ -74,6 +74,9 @@ pub enum TrajectoryError {
         /// Cause.
         source: CycleError,
     },
+    /// The assembled dataset failed [`Dataset::validate`].
+    #[error("the generated dataset is invalid: {0}")]
+    Invalid(#[from] DatasetError),
 }
 
 /// Trajectory family (shape of the tip path).
@@ -562,8 +565,8 @@ impl GeneratorConfig {
 
 /// Kinematics-only dataset: analytic inputs at the dataset rate, `outputs = None`, U_ref as
 /// published ([`cycles::published_u_ref`], R = [`U_REF_RADIUS_M`]), family labels, metadata with
-/// generator `"flapssm trajectories"`, the seed and the full [`GeneratorConfig`].
-pub fn kinematics_dataset(cfg: &GeneratorConfig) -> Result<Dataset, TrajectoryError> {
+/// generator `"flapssm trajectories"`, the seed and the full [`GeneratorConfig`], checked once.
+pub fn kinematics_dataset(cfg: &GeneratorConfig) -> Result<ValidDataset, TrajectoryError> {
     let specs = cfg.generate()?;
     let dt_s = cfg.sampling.dataset_dt_s();
     let mut trajectories = Vec::with_capacity(specs.len());
@@ -586,7 +589,7 @@ pub fn kinematics_dataset(cfg: &GeneratorConfig) -> Result<Dataset, TrajectoryEr
         });
     }
     let settings = serde_json::to_value(cfg).unwrap_or(serde_json::Value::Null);
-    Ok(Dataset {
+    let ds = Dataset {
         meta: DatasetMeta {
             format_version: FORMAT_VERSION,
             wing: WingGeometry::default(),
@@ -600,7 +603,8 @@ pub fn kinematics_dataset(cfg: &GeneratorConfig) -> Result<Dataset, TrajectoryEr
         dt_s,
         trajectories,
         n_train: cfg.n_train,
-    })
+    };
+    Ok(ValidDataset::new(ds)?)
 }
 
 #[cfg(test)]
