@@ -10,7 +10,7 @@ use flapssm_data::npz::{NpyData, NpzWriter};
 use flapssm_prssm::predict::Prediction;
 use flapssm_prssm::train::InitialStateSpec;
 use flapssm_prssm::train::fit::training_record;
-use flapssm_prssm::{PrssmModel, Sequence};
+use flapssm_prssm::{PrssmModel, SequenceView};
 use flapssm_wing::dataset::{Trajectory, ValidDataset};
 
 use crate::error::{JobError, Result};
@@ -19,16 +19,12 @@ use crate::models::prssm::PrssmLoadModel;
 use crate::progress::Progress;
 use crate::seed::prediction_seed;
 
-/// The raw PR-SSM sequence of a trajectory (7 inputs, 5 outputs, row-major; outputs empty for
-/// kinematics-only trajectories).
-pub fn trajectory_sequence(t: &Trajectory) -> Sequence {
-    Sequence {
-        inputs: t.inputs.as_flattened().to_vec(),
-        outputs: t
-            .outputs
-            .as_ref()
-            .map(|y| y.as_flattened().to_vec())
-            .unwrap_or_default(),
+/// The raw PR-SSM sequence of a trajectory, a view of its own arrays (7 inputs, 5 outputs,
+/// row-major; outputs empty for kinematics-only trajectories).
+pub fn trajectory_sequence(t: &Trajectory) -> SequenceView<'_> {
+    SequenceView {
+        inputs: t.inputs.as_flattened(),
+        outputs: t.outputs.as_deref().map_or(&[], <[[f64; 5]]>::as_flattened),
     }
 }
 

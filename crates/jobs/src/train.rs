@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 
-use flapssm_prssm::Sequence;
+use flapssm_prssm::SequenceView;
 use flapssm_prssm::train::fit::{FitError, FitOutcome, FitSpec, Preset, fit};
 use flapssm_prssm::train::{Budget, Checkpoint, LrSchedule, TrainEvent, TrainHooks};
 use flapssm_wing::dataset::{Trajectory, ValidDataset};
@@ -248,8 +248,8 @@ pub fn train_prssm(
     stop: Option<&AtomicBool>,
 ) -> Result<FitOutcome> {
     let (fit_set, val_set) = plan.split(train)?;
-    let fit_seqs: Vec<Sequence> = fit_set.iter().map(trajectory_sequence).collect();
-    let val_seqs: Vec<Sequence> = val_set.iter().map(trajectory_sequence).collect();
+    let fit_seqs: Vec<SequenceView<'_>> = fit_set.iter().map(trajectory_sequence).collect();
+    let val_seqs: Vec<SequenceView<'_>> = val_set.iter().map(trajectory_sequence).collect();
     let mut on_event = |e: &TrainEvent<'_>| match e {
         TrainEvent::Step {
             step,

@@ -45,7 +45,7 @@ pub mod train;
 
 pub use elbo::{
     Elbo, ElboError, ElboOptions, InitialStateGrads, InitialStateMode, InitialStates, LossParts,
-    LossScaling, Sequence, TrainingData,
+    LossScaling, Sequence, SequenceView, TrainingData,
 };
 pub use io::ModelFileError;
 pub use kernel::KernelKind;

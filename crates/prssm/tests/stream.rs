@@ -75,7 +75,7 @@ fn streaming_equals_batch_prediction_bit_for_bit() {
             inputs: u.clone(),
             outputs: Vec::new(),
         };
-        let batch = predict_raw(&model, &seq, 25, 99).unwrap();
+        let batch = predict_raw(&model, seq.view(), 25, 99).unwrap();
         let mut stream =
             StreamPredictor::new(&model, 25, &vec![0.0; dx], &vec![0.0; dx], 99).unwrap();
         for t in 0..t_n {

@@ -13,7 +13,7 @@ use flapssm_prssm::train::{
 };
 use flapssm_prssm::{
     ElboOptions, InitialStateMode, KernelKind, LossScaling, ModelConfig, Objective, ParamInit,
-    Params, Sequence, TrainingData, Window,
+    Params, Sequence, SequenceView, TrainingData, Window,
 };
 
 fn sequences(data: &flapssm_prssm::systems::SimulatedData) -> Vec<Sequence> {
@@ -139,7 +139,7 @@ fn learns_a_forced_duffing_oscillator_with_calibrated_intervals() {
     };
     let out = fit(
         &spec,
-        &train,
+        &views(&train),
         &[],
         TrainHooks {
             progress: Some(&mut progress),
@@ -155,7 +155,7 @@ fn learns_a_forced_duffing_oscillator_with_calibrated_intervals() {
 
     let (mut se, mut inside, mut n) = (0.0, 0, 0);
     for (i, seq) in test.iter().enumerate() {
-        let pred = predict_raw(&out.last, seq, 100, 1000 + i as u64).unwrap();
+        let pred = predict_raw(&out.last, seq.view(), 100, 1000 + i as u64).unwrap();
         for t in 0..seq.outputs.len() {
             let (m, v, y) = (pred.output_mean[t], pred.output_var[t], seq.outputs[t]);
             se += (m - y) * (m - y);
@@ -210,8 +210,8 @@ fn fit_with_validation_is_independent_of_the_thread_count() {
             };
             let out = fit(
                 &spec,
-                &train,
-                &val,
+                &views(&train),
+                &views(&val),
                 TrainHooks {
                     progress: Some(&mut progress),
                     ..TrainHooks::default()
@@ -231,4 +231,8 @@ fn fit_with_validation_is_independent_of_the_thread_count() {
         assert_eq!((bits(*t1), bits(*v1)), (bits(*t3), bits(*v3)));
     }
     assert!(p1.iter().zip(&p3).all(|(a, b)| a.to_bits() == b.to_bits()));
+}
+
+fn views(sequences: &[Sequence]) -> Vec<SequenceView<'_>> {
+    sequences.iter().map(Sequence::view).collect()
 }

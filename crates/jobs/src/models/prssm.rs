@@ -88,7 +88,7 @@ impl<'m> PrssmLoadModel<'m> {
     pub fn predict(&self, index: usize, trajectory: &Trajectory) -> Result<Prediction> {
         predict_raw(
             &self.model,
-            &trajectory_sequence(trajectory),
+            trajectory_sequence(trajectory),
             self.particles,
             prediction_seed(self.seed, index),
         )

@@ -3,7 +3,7 @@
 use std::path::Path;
 
 use flapssm_data::table::{Column, Table, TableError};
-use flapssm_prssm::Sequence;
+use flapssm_prssm::SequenceView;
 
 use super::SysidError;
 
@@ -103,12 +103,12 @@ impl IoRecord {
         }
     }
 
-    /// The samples `range` as a raw PR-SSM sequence.
-    pub(super) fn sequence(&self, range: std::ops::Range<usize>) -> Sequence {
+    /// The samples `range` as a raw PR-SSM sequence (a view, no copy).
+    pub(super) fn sequence(&self, range: std::ops::Range<usize>) -> SequenceView<'_> {
         let (du, dy) = (self.input_names.len(), self.output_names.len());
-        Sequence {
-            inputs: self.inputs[range.start * du..range.end * du].to_vec(),
-            outputs: self.outputs[range.start * dy..range.end * dy].to_vec(),
+        SequenceView {
+            inputs: &self.inputs[range.start * du..range.end * du],
+            outputs: &self.outputs[range.start * dy..range.end * dy],
         }
     }
 }

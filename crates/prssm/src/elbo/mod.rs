@@ -39,6 +39,66 @@ pub struct Sequence {
     pub outputs: Vec<f64>,
 }
 
+/// A borrowed sequence: the caller's own `T × D_u` inputs and `T × D_y` outputs (row-major),
+/// with no copy. The raw data of [`crate::train::fit::fit`] and
+/// [`crate::train::fit::predict_raw`] come in as views.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SequenceView<'a> {
+    /// Inputs `u`, row-major `T × D_u`.
+    pub inputs: &'a [f64],
+    /// Outputs `y`, row-major `T × D_y` (empty where none are known).
+    pub outputs: &'a [f64],
+}
+
+impl Sequence {
+    /// This sequence as a view.
+    pub fn view(&self) -> SequenceView<'_> {
+        SequenceView {
+            inputs: &self.inputs,
+            outputs: &self.outputs,
+        }
+    }
+}
+
+/// Checks that every sequence has `T × D_u` inputs and `T × D_y` outputs, `T ≥ 1`, finite, and
+/// returns each `T`.
+///
+/// # Errors
+/// [`ElboError::Sequence`] naming the sequence.
+pub fn sequence_lengths<'a>(
+    n_input: usize,
+    n_output: usize,
+    sequences: impl IntoIterator<Item = SequenceView<'a>>,
+) -> Result<Vec<usize>, ElboError> {
+    let mut lens = Vec::new();
+    for (index, s) in sequences.into_iter().enumerate() {
+        let err = |message: String| Err(ElboError::Sequence { index, message });
+        if n_output == 0 || s.outputs.len() % n_output != 0 || s.outputs.is_empty() {
+            return err(format!(
+                "{} output values are not a T × {n_output} array with T ≥ 1",
+                s.outputs.len()
+            ));
+        }
+        let t = s.outputs.len() / n_output;
+        if s.inputs.len() != t * n_input {
+            return err(format!(
+                "{} input values, expected {t} × {n_input}",
+                s.inputs.len()
+            ));
+        }
+        if let Some(i) = s
+            .inputs
+            .iter()
+            .chain(s.outputs)
+            .position(|v| !v.is_finite())
+        {
+            return err(format!("non-finite value at flat index {i}"));
+        }
+        lens.push(t);
+    }
+    Ok(lens)
+}
+
 /// Validated training sequences.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TrainingData {
@@ -74,7 +134,7 @@ pub enum ElboError {
 }
 
 impl TrainingData {
-    /// Checks that every sequence has `T × D_u` inputs and `T × D_y` outputs, `T ≥ 1`, finite.
+    /// Checks the sequences ([`sequence_lengths`]) and takes them.
     ///
     /// # Errors
     /// [`ElboError::Sequence`] naming the sequence.
@@ -83,32 +143,7 @@ impl TrainingData {
         n_output: usize,
         sequences: Vec<Sequence>,
     ) -> Result<Self, ElboError> {
-        let mut lens = Vec::with_capacity(sequences.len());
-        for (index, s) in sequences.iter().enumerate() {
-            let err = |message: String| Err(ElboError::Sequence { index, message });
-            if n_output == 0 || s.outputs.len() % n_output != 0 || s.outputs.is_empty() {
-                return err(format!(
-                    "{} output values are not a T × {n_output} array with T ≥ 1",
-                    s.outputs.len()
-                ));
-            }
-            let t = s.outputs.len() / n_output;
-            if s.inputs.len() != t * n_input {
-                return err(format!(
-                    "{} input values, expected {t} × {n_input}",
-                    s.inputs.len()
-                ));
-            }
-            if let Some(i) = s
-                .inputs
-                .iter()
-                .chain(&s.outputs)
-                .position(|v| !v.is_finite())
-            {
-                return err(format!("non-finite value at flat index {i}"));
-            }
-            lens.push(t);
-        }
+        let lens = sequence_lengths(n_input, n_output, sequences.iter().map(Sequence::view))?;
         Ok(Self {
             n_input,
             n_output,

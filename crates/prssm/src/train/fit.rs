@@ -31,7 +31,8 @@ use super::trainer::{
     Budget, Evaluation, TrainConfig, TrainError, TrainHooks, TrainOutcome, train,
 };
 use crate::elbo::{
-    Elbo, ElboError, ElboOptions, InitialStateMode, LossScaling, Sequence, TrainingData,
+    Elbo, ElboError, ElboOptions, InitialStateMode, LossScaling, Sequence, SequenceView,
+    TrainingData, sequence_lengths,
 };
 use crate::kernel::KernelKind;
 use crate::model::{Normalization, PrssmModel};
@@ -186,8 +187,12 @@ pub struct FitOutcome {
 }
 
 /// Training-set normalization: per-channel mean and std (ddof 0; std 1 for constant channels).
-pub fn normalization(sequences: &[Sequence], n_input: usize, n_output: usize) -> Normalization {
-    let stats = |d: usize, get: &dyn Fn(&Sequence) -> &[f64]| {
+pub fn normalization<'a>(
+    sequences: &[SequenceView<'a>],
+    n_input: usize,
+    n_output: usize,
+) -> Normalization {
+    let stats = |d: usize, get: &dyn Fn(&SequenceView<'a>) -> &'a [f64]| {
         let mut mean = vec![0.0; d];
         let mut n = 0.0;
         for s in sequences {
@@ -214,8 +219,8 @@ pub fn normalization(sequences: &[Sequence], n_input: usize, n_output: usize) ->
             .collect::<Vec<_>>();
         (mean, std)
     };
-    let (input_mean, input_std) = stats(n_input, &|s| &s.inputs);
-    let (output_mean, output_std) = stats(n_output, &|s| &s.outputs);
+    let (input_mean, input_std) = stats(n_input, &|s| s.inputs);
+    let (output_mean, output_std) = stats(n_output, &|s| s.outputs);
     Normalization {
         input_mean,
         input_std,
@@ -224,8 +229,8 @@ pub fn normalization(sequences: &[Sequence], n_input: usize, n_output: usize) ->
     }
 }
 
-/// Standardizes a raw sequence with `norm`.
-pub fn standardize(s: &Sequence, norm: &Normalization) -> Sequence {
+/// Standardizes a raw sequence with `norm` (a new sequence).
+pub fn standardize(s: SequenceView<'_>, norm: &Normalization) -> Sequence {
     let z = |v: &[f64], mean: &[f64], std: &[f64]| -> Vec<f64> {
         let d = mean.len().max(1);
         v.iter()
@@ -234,8 +239,8 @@ pub fn standardize(s: &Sequence, norm: &Normalization) -> Sequence {
             .collect()
     };
     Sequence {
-        inputs: z(&s.inputs, &norm.input_mean, &norm.input_std),
-        outputs: z(&s.outputs, &norm.output_mean, &norm.output_std),
+        inputs: z(s.inputs, &norm.input_mean, &norm.input_std),
+        outputs: z(s.outputs, &norm.output_mean, &norm.output_std),
     }
 }
 
@@ -248,7 +253,7 @@ pub fn predict_standardized(
     config: &ModelConfig,
     params: &Params,
     initial: &InitialStateModel,
-    seq: &Sequence,
+    seq: SequenceView<'_>,
     particles: usize,
     seed: u64,
 ) -> Result<Prediction, FitError> {
@@ -256,20 +261,14 @@ pub fn predict_standardized(
     let (mut m0, mut s0) = (vec![0.0; dx], vec![0.0; dx]);
     initial.state(
         (config.n_input, config.n_output),
-        &seq.inputs,
-        &seq.outputs,
+        seq.inputs,
+        seq.outputs,
         0,
         &mut m0,
         &mut s0,
     )?;
     Ok(predict::predict(
-        config,
-        params,
-        &seq.inputs,
-        &m0,
-        &s0,
-        particles,
-        seed,
+        config, params, seq.inputs, &m0, &s0, particles, seed,
     )?)
 }
 
@@ -305,8 +304,8 @@ pub fn training_record(model: &PrssmModel) -> Result<TrainingRecord, FitError> {
 /// [`FitError`] for invalid data, configuration or a failed run.
 pub fn fit(
     spec: &FitSpec,
-    train_raw: &[Sequence],
-    val_raw: &[Sequence],
+    train_raw: &[SequenceView<'_>],
+    val_raw: &[SequenceView<'_>],
     hooks: TrainHooks<'_>,
     resume: Option<Checkpoint>,
 ) -> Result<FitOutcome, FitError> {
@@ -314,13 +313,12 @@ pub fn fit(
     cfg.check()?;
     let (du, dy) = (cfg.n_input, cfg.n_output);
     // Validate shapes before computing statistics.
-    TrainingData::new(du, dy, train_raw.to_vec())?;
-    TrainingData::new(du, dy, val_raw.to_vec())?;
+    let lens = sequence_lengths(du, dy, train_raw.iter().copied())?;
+    sequence_lengths(du, dy, val_raw.iter().copied())?;
     let norm = normalization(train_raw, du, dy);
-    let train_z: Vec<Sequence> = train_raw.iter().map(|s| standardize(s, &norm)).collect();
-    let val_z: Vec<Sequence> = val_raw.iter().map(|s| standardize(s, &norm)).collect();
-    let data = TrainingData::new(du, dy, train_z.clone())?;
-    let lens = data.lens().to_vec();
+    let train_z: Vec<Sequence> = train_raw.iter().map(|s| standardize(*s, &norm)).collect();
+    let val_z: Vec<Sequence> = val_raw.iter().map(|s| standardize(*s, &norm)).collect();
+    let data = TrainingData::new(du, dy, train_z)?;
     let plan = BatchPlan::new(&lens, spec.train.windows, spec.train.batch_size)
         .map_err(TrainError::from)?;
     let options = ElboOptions {
@@ -336,6 +334,7 @@ pub fn fit(
         windows_per_task: 4,
     };
     let elbo = Elbo::new(cfg.clone(), data, options)?;
+    let train_z = elbo.data().sequences();
     let seed = spec.train.seed;
     let mut init = Params::init(cfg, &spec.init, derive_seed(seed, 3, 0)).unconstrained(cfg);
     let recognized = match spec.initial_state {
@@ -366,7 +365,7 @@ pub fn fit(
                 cfg,
                 &p,
                 &initial,
-                seq,
+                seq.view(),
                 spec.eval_particles,
                 derive_seed(eval_seed, 6, i as u64),
             )
@@ -444,7 +443,7 @@ pub fn fit(
 /// [`FitError`] for mismatched shapes, a missing initial-state input or a failed prediction.
 pub fn predict_raw(
     model: &PrssmModel,
-    seq: &Sequence,
+    seq: SequenceView<'_>,
     particles: usize,
     seed: u64,
 ) -> Result<Prediction, FitError> {
@@ -457,12 +456,10 @@ pub fn predict_raw(
         },
     };
     let dy = model.config.n_output;
-    let z = match &model.normalization {
-        Some(n) => standardize(seq, n),
-        None => seq.clone(),
-    };
+    let z = model.normalization.as_ref().map(|n| standardize(seq, n));
+    let z = z.as_ref().map_or(seq, Sequence::view);
     let mut pred =
-        predict_standardized(&model.config, &model.params, &initial, &z, particles, seed)?;
+        predict_standardized(&model.config, &model.params, &initial, z, particles, seed)?;
     if let Some(n) = &model.normalization {
         for (i, (m, v)) in pred
             .output_mean
@@ -479,11 +476,11 @@ pub fn predict_raw(
 }
 
 /// A fingerprint of raw sequences: count, total length and an FNV-1a hash of every value's bits.
-fn data_fingerprint(sequences: &[Sequence]) -> serde_json::Value {
+fn data_fingerprint(sequences: &[SequenceView<'_>]) -> serde_json::Value {
     let mut hash: u64 = 0xcbf2_9ce4_8422_2325;
     let mut n_values = 0usize;
     for s in sequences {
-        for x in s.inputs.iter().chain(&s.outputs) {
+        for x in s.inputs.iter().chain(s.outputs) {
             for byte in x.to_bits().to_le_bytes() {
                 hash = (hash ^ u64::from(byte)).wrapping_mul(0x0000_0100_0000_01b3);
             }
