@@ -192,7 +192,27 @@ fn tiny_demo_evaluate_and_sweep() {
         tmp.path().join("x.json").to_str().unwrap(),
     ]);
     assert!(!o.status.success());
-    assert!(String::from_utf8_lossy(&o.stderr).contains("data-size value"));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("value = 99: a data size in 2 ..="));
+    // Checked against the dataset before any training (the epochs would take minutes).
+    let o = flapssm(&[
+        "sweep",
+        "run",
+        "--kind",
+        "dx",
+        "--value",
+        "6",
+        "--epochs",
+        "100000",
+        "--start-sample",
+        "5000",
+        "--dataset",
+        ds.to_str().unwrap(),
+        "--out",
+        tmp.path().join("x.json").to_str().unwrap(),
+    ]);
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("start_sample = 5000: must be below"));
+    assert!(!tmp.path().join("x.json").exists());
     let missing = tmp.path().join("missing.json");
     let o = flapssm(&[
         "evaluate",

@@ -35,13 +35,13 @@ use crate::evaluate::{
     versions,
 };
 use crate::files::{load_json, save_json};
-use crate::models::arx::ArxSettings;
+use crate::models::arx::{ArxFit, ArxSettings};
 use crate::models::lrqsm::LrqsmLoadModel;
 use crate::models::prssm::PrssmLoadModel;
 use crate::models::{Fit, LoadModel};
 use crate::progress::Progress;
 use crate::simulate::simulate;
-use crate::train::{TrainingOptions, train_prssm};
+use crate::train::{TrainingOptions, TrainingPlan, train_prssm};
 use flapssm_analysis::stats::{Interval, median};
 
 /// Format tag of `summary.json`.
@@ -138,6 +138,35 @@ impl DemoConfig {
             },
         }
     }
+
+    /// Checks every setting before any work: the wing and its trajectories, the LRQSM's
+    /// elastic net, the PR-SSM training, the ARX baseline and the evaluation.
+    ///
+    /// # Errors
+    /// The first invalid setting, named ([`JobError::Setting`], or the library's own error
+    /// naming the field).
+    pub fn check(&self) -> Result<DemoPlan> {
+        self.simulation.wing.check()?;
+        self.simulation
+            .trajectories
+            .check()
+            .map_err(flapssm_wing::virtual_wing::SimulateError::from)?;
+        self.lrqsm.validate()?;
+        self.evaluation.check()?;
+        Ok(DemoPlan {
+            training: self.training.check()?,
+            arx: self.arx.check()?,
+        })
+    }
+}
+
+/// The checked parts of a [`DemoConfig`] that the stages run ([`DemoConfig::check`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct DemoPlan {
+    /// PR-SSM training.
+    pub training: TrainingPlan,
+    /// The ARX baseline.
+    pub arx: ArxFit,
 }
 
 /// Wall time of one stage.
@@ -288,11 +317,12 @@ fn json<T: Serialize>(v: &T) -> serde_json::Value {
     serde_json::to_value(v).unwrap_or(serde_json::Value::Null)
 }
 
-/// Runs the demo into `dir` (created if needed). `stop` interrupts the training, which can
-/// then be resumed by running again with the same configuration.
+/// Runs the demo into `dir` (created if needed), after [`DemoConfig::check`]. `stop` interrupts
+/// the training, which can then be resumed by running again with the same configuration.
 ///
 /// # Errors
-/// Any stage's error, naming the stage's file; [`JobError::Interrupted`] when stopped.
+/// An invalid setting before any work; any stage's error, naming the stage's file;
+/// [`JobError::Interrupted`] when stopped.
 pub fn run_demo(
     dir: &Path,
     cfg: &DemoConfig,
@@ -300,9 +330,10 @@ pub fn run_demo(
     stop: Option<&AtomicBool>,
 ) -> Result<DemoSummary> {
     let t_all = Instant::now();
-    let plan = cfg.training.check()?;
-    let arx_fit = cfg.arx.check()?;
-    cfg.evaluation.check()?;
+    let DemoPlan {
+        training: plan,
+        arx: arx_fit,
+    } = cfg.check()?;
     std::fs::create_dir_all(dir).map_err(|source| JobError::Io {
         path: dir.to_path_buf(),
         source,
@@ -529,5 +560,36 @@ fn summarize(
         total_wall_s,
         versions: versions(),
         report: "eval/report.html".into(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::progress::NoProgress;
+
+    /// A bad setting of any part fails before the demo creates its directory, naming the setting.
+    #[test]
+    fn every_setting_is_checked_before_any_work() {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("demo");
+        let cases: [(&str, fn(&mut DemoConfig)); 5] = [
+            ("n_train", |c| c.simulation.trajectories.n_train = 500),
+            ("fluid.kinematic_viscosity_m2_s", |c| {
+                c.simulation.wing.fluid.kinematic_viscosity_m2_s = 0.0
+            }),
+            ("n_folds", |c| c.lrqsm.n_folds = 1),
+            ("epochs", |c| c.training.epochs = Some(0)),
+            ("particles", |c| c.evaluation.particles = 0),
+        ];
+        for (name, edit) in cases {
+            let mut cfg = DemoConfig::default_for(1);
+            edit(&mut cfg);
+            let e = run_demo(&out, &cfg, &NoProgress, None).unwrap_err();
+            assert!(e.to_string().contains(name), "{name}: {e}");
+            assert!(!out.exists(), "{name}: work started");
+        }
+        assert!(DemoConfig::default_for(1).check().is_ok());
+        assert!(DemoConfig::full(1).check().is_ok());
     }
 }

@@ -20,7 +20,7 @@ use crate::error::{JobError, Result};
 use crate::files::save_json;
 use crate::predict::predict_prssm;
 use crate::progress::Progress;
-use crate::train::{TrainingOptions, train_prssm};
+use crate::train::{TrainingOptions, TrainingPlan, train_prssm};
 use flapssm_analysis::metrics::PooledErrors;
 use flapssm_analysis::stats::Rows;
 
@@ -116,51 +116,119 @@ pub struct SweepResult {
     pub history: Vec<EpochRecord>,
 }
 
-/// Trains and evaluates one configuration: `kind = value` on top of `opts`. Predictions use
-/// `particles` particles and `seed`; errors count from `start_sample` on.
+/// Settings of one sweep run: `kind = value` on top of the training options; predictions with
+/// `particles` particles and `seed`; errors counted from `start_sample` on.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SweepSettings {
+    /// What is swept.
+    pub kind: SweepKind,
+    /// Its value in this run.
+    pub value: usize,
+    /// The training options the value is set on.
+    pub training: TrainingOptions,
+    /// Particles of the predictions.
+    pub particles: usize,
+    /// Seed of the predictions.
+    pub seed: u64,
+    /// First sample of the errors (0-based; published 93).
+    pub start_sample: usize,
+}
+
+/// [`SweepSettings`] checked against a dataset ([`SweepSettings::check`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SweepPlan {
+    settings: SweepSettings,
+    options: TrainingOptions,
+    training: TrainingPlan,
+    used: usize,
+}
+
+impl SweepSettings {
+    /// Checks every setting against `ds` before any work.
+    ///
+    /// # Errors
+    /// [`JobError::Setting`] for a data-size value outside `2 ..= n_train`, no prediction
+    /// particle, a `start_sample` at or past the trajectories' length; the training options'
+    /// errors.
+    pub fn check(&self, ds: &ValidDataset) -> Result<SweepPlan> {
+        let setting = |name: &str, value: String, expected: String| JobError::Setting {
+            name: name.into(),
+            value,
+            expected,
+        };
+        let n_train = ds.n_train;
+        let mut options = self.training.clone();
+        let used = match self.kind {
+            SweepKind::Dx => {
+                options.dx = Some(self.value);
+                n_train
+            }
+            SweepKind::DataSize => {
+                if self.value < 2 || self.value > n_train {
+                    return Err(setting(
+                        "value",
+                        self.value.to_string(),
+                        format!("a data size in 2 ..= {n_train} (the training trajectories)"),
+                    ));
+                }
+                self.value
+            }
+        };
+        if self.particles == 0 {
+            return Err(setting(
+                "eval_particles",
+                "0".into(),
+                "must be at least 1".into(),
+            ));
+        }
+        if self.start_sample >= ds.n_samples() {
+            return Err(setting(
+                "start_sample",
+                self.start_sample.to_string(),
+                format!(
+                    "must be below the {} samples of each trajectory",
+                    ds.n_samples()
+                ),
+            ));
+        }
+        ds.standardization()?;
+        Ok(SweepPlan {
+            settings: self.clone(),
+            training: options.check()?,
+            options,
+            used,
+        })
+    }
+}
+
+/// Trains and evaluates one configuration ([`SweepSettings`], checked against `ds`).
 ///
 /// # Errors
-/// [`JobError::Mismatch`] for a value that does not fit the dataset (data-size larger than
-/// the training set or below 2), training and prediction errors.
-#[allow(clippy::too_many_arguments)]
+/// Training and prediction errors.
 pub fn sweep_run(
     ds: &ValidDataset,
     dataset_label: &str,
-    kind: SweepKind,
-    value: usize,
-    opts: &TrainingOptions,
-    particles: usize,
-    seed: u64,
-    start_sample: usize,
+    plan: &SweepPlan,
     progress: &dyn Progress,
     stop: Option<&AtomicBool>,
 ) -> Result<SweepResult> {
+    let SweepSettings {
+        kind,
+        value,
+        particles,
+        seed,
+        start_sample,
+        ..
+    } = plan.settings;
+    let (used, opts) = (plan.used, plan.options.clone());
+    let plan = &plan.training;
     let stats = ds.standardization()?;
-    let n_train = ds.n_train.min(ds.len());
-    let mut opts = opts.clone();
-    let used = match kind {
-        SweepKind::Dx => {
-            opts.dx = Some(value);
-            n_train
-        }
-        SweepKind::DataSize => {
-            if value < 2 || value > n_train {
-                return Err(JobError::Mismatch {
-                    what: "data-size value".into(),
-                    expected: format!("2 ..= {n_train} (the training trajectories)"),
-                    found: value.to_string(),
-                });
-            }
-            value
-        }
-    };
-    let plan = opts.check()?;
     let train = &ds.trajectories[..used];
     let (fit_set, val_set) = plan.split(train)?;
     let (n_fit, n_val) = (fit_set.len(), val_set.len());
     progress.start(&format!("train {} = {value}", kind.name()), 0);
     let t0 = Instant::now();
-    let out = train_prssm(train, &plan, None, None, progress, stop)?;
+    let out = train_prssm(train, plan, None, None, progress, stop)?;
     let train_wall_s = t0.elapsed().as_secs_f64();
     progress.finish("");
 

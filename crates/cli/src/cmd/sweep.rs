@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use anyhow::Context;
 use clap::{Args, Subcommand};
 use flapssm_jobs::files::save_json;
-use flapssm_jobs::sweep::{SweepKind, SweepTable, load_result, sweep_run};
+use flapssm_jobs::sweep::{SweepKind, SweepSettings, SweepTable, load_result, sweep_run};
 use flapssm_jobs::train::TrainingOptions;
 use flapssm_prssm::train::fit::Preset;
 use flapssm_wing::dataset::Dataset;
@@ -97,7 +97,7 @@ pub fn run(cmd: SweepCommand) -> anyhow::Result<()> {
 fn run_one(a: RunArgs) -> anyhow::Result<()> {
     let ds = Dataset::load(&a.dataset)
         .with_context(|| format!("loading dataset {}", a.dataset.display()))?;
-    let opts = TrainingOptions {
+    let training = TrainingOptions {
         preset: a.preset,
         dx: a.dx,
         inducing: a.inducing,
@@ -112,16 +112,20 @@ fn run_one(a: RunArgs) -> anyhow::Result<()> {
         val_fraction: a.val_fraction,
         checkpoint_every: 0,
     };
+    let plan = SweepSettings {
+        kind: a.kind,
+        value: a.value,
+        training,
+        particles: a.eval_particles,
+        seed: a.seed,
+        start_sample: a.start_sample,
+    }
+    .check(&ds)?;
     let stop = stop_flag()?;
     let r = sweep_run(
         &ds,
         &a.dataset.display().to_string(),
-        a.kind,
-        a.value,
-        &opts,
-        a.eval_particles,
-        a.seed,
-        a.start_sample,
+        &plan,
         &Bars::new(),
         Some(&stop),
     )
