@@ -573,7 +573,8 @@ mod tests {
     fn every_setting_is_checked_before_any_work() {
         let dir = tempfile::tempdir().unwrap();
         let out = dir.path().join("demo");
-        let cases: [(&str, fn(&mut DemoConfig)); 5] = [
+        type Edit = fn(&mut DemoConfig);
+        let cases: [(&str, Edit); 5] = [
             ("n_train", |c| c.simulation.trajectories.n_train = 500),
             ("fluid.kinematic_viscosity_m2_s", |c| {
                 c.simulation.wing.fluid.kinematic_viscosity_m2_s = 0.0
