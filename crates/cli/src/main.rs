@@ -28,6 +28,8 @@ enum Command {
     Model(cmd::model::ModelArgs),
     /// Open-loop PR-SSM prediction.
     Predict(cmd::predict::PredictArgs),
+    /// Real-time PR-SSM prediction: input rows on stdin, predictions on stdout as they arrive.
+    Stream(cmd::stream::StreamArgs),
     /// Train a PR-SSM on a dataset (presets paper, sysid; checkpoints, --resume).
     Train(cmd::train::TrainArgs),
     /// Measure PR-SSM training, prediction and streaming speed.
@@ -83,6 +85,7 @@ fn run(command: Command) -> anyhow::Result<()> {
         Command::Dataset(args) => cmd::dataset::run(args),
         Command::Model(args) => cmd::model::run(args),
         Command::Predict(args) => cmd::predict::run(args),
+        Command::Stream(args) => cmd::stream::run(args),
         Command::Train(args) => cmd::train::run(args),
         Command::Bench(args) => cmd::bench::run(args),
         Command::Trajectories(args) => cmd::trajectories::run(args),

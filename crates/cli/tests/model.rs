@@ -179,3 +179,68 @@ fn wrong_input_width_is_refused_naming_the_csv() {
     let o = flapssm(&["predict", s(&model), "--inputs", s(&csv), "--out", s(&out)]);
     assert_fails(&o, &[s(&csv), "6 columns", "D_u = 7"], &out);
 }
+
+/// Runs `flapssm stream ARGS` with `stdin` piped in.
+fn stream(args: &[&str], stdin: &[u8]) -> std::process::Output {
+    use std::io::Write;
+    use std::process::{Command, Stdio};
+    let mut child = Command::new(env!("CARGO_BIN_EXE_flapssm"))
+        .arg("stream")
+        .args(args)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    child.stdin.take().unwrap().write_all(stdin).unwrap();
+    child.wait_with_output().unwrap()
+}
+
+/// `flapssm stream` on the authors' inputs writes exactly what `predict --inputs` writes for
+/// the same seed (one step shared by both); a malformed row stops it with the line named.
+#[test]
+fn streaming_the_published_inputs_equals_the_batch_prediction() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = dir.path().join("published.json");
+    ok(&[
+        "model",
+        "import-published",
+        s(&reference_npz()),
+        "--out",
+        s(&model),
+    ]);
+    let inputs = dir.path().join("u_in.csv");
+    write_inputs(&mut NpzReader::open(reference_npz()).unwrap(), &inputs);
+    let batch = dir.path().join("batch.csv");
+    ok(&[
+        "predict",
+        s(&model),
+        "--inputs",
+        s(&inputs),
+        "--particles",
+        "12",
+        "--seed",
+        "5",
+        "--out",
+        s(&batch),
+    ]);
+    let text = std::fs::read(&inputs).unwrap();
+    let o = stream(&[s(&model), "--particles", "12", "--seed", "5"], &text);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(o.stdout, std::fs::read(&batch).unwrap());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("470 steps"));
+
+    let cut = text[..text.len() / 2]
+        .iter()
+        .rposition(|&b| b == b'\n')
+        .unwrap();
+    let mut bad = text[..=cut].to_vec();
+    bad.extend_from_slice(b"1,2,3\n");
+    let o = stream(&[s(&model)], &bad);
+    assert!(!o.status.success());
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("<stdin> line") && err.contains("3 columns, expected the model's 7 inputs"),
+        "{err}"
+    );
+}

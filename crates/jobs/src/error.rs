@@ -88,6 +88,16 @@ pub enum JobError {
         /// Cause.
         source: std::io::Error,
     },
+    /// A line of a text input is malformed (line 0: the input as a whole).
+    #[error("{path} line {line}: {message}")]
+    Parse {
+        /// The input.
+        path: PathBuf,
+        /// 1-based line.
+        line: usize,
+        /// What is wrong.
+        message: String,
+    },
     /// A JSON file could not be parsed or written.
     #[error("{path}: {source}")]
     Json {

@@ -8,6 +8,7 @@
 //! | [`simulate`] | the virtual wing on seeded random trajectories, into a dataset |
 //! | [`train`] | PR-SSM training on a dataset's training trajectories (settings, checkpoints, resume) |
 //! | [`predict`] | open-loop predictions of every trajectory of a dataset (PR-SSM, LRQSM) |
+//! | [`stream`] | real-time PR-SSM prediction, one sample at a time (CSV in, CSV out) |
 //! | [`models`] | the load models behind one trait (PR-SSM, LRQSM, ARX) |
 //! | [`evaluate`] | both models on a dataset: metrics, authority, figures, report |
 //! | [`sweep`] | one-configuration PR-SSM sweep runs (D_x, training-set size) and their merge |
@@ -30,6 +31,7 @@ pub mod predict;
 pub mod progress;
 pub mod seed;
 pub mod simulate;
+pub mod stream;
 pub mod sweep;
 pub mod sysid;
 #[cfg(test)]

@@ -8,8 +8,6 @@ use std::path::Path;
 
 use flapssm_data::npz::{NpyData, NpzWriter};
 use flapssm_prssm::predict::Prediction;
-use flapssm_prssm::train::InitialStateSpec;
-use flapssm_prssm::train::fit::training_record;
 use flapssm_prssm::{PrssmModel, SequenceView};
 use flapssm_wing::dataset::{Trajectory, ValidDataset};
 
@@ -18,6 +16,7 @@ use crate::models::map_trajectories;
 use crate::models::prssm::PrssmLoadModel;
 use crate::progress::Progress;
 use crate::seed::prediction_seed;
+use crate::stream::inputs_only_notes;
 
 /// The raw PR-SSM sequence of a trajectory, a view of its own arrays (7 inputs, 5 outputs,
 /// row-major; outputs empty for kinematics-only trajectories).
@@ -186,21 +185,7 @@ pub fn predict_inputs(
             found: format!("{n_columns} columns"),
         });
     }
-    let mut notes = Vec::new();
-    if let Ok(r) = training_record(model) {
-        let rule = match r.initial_state.spec {
-            InitialStateSpec::Zeros => None,
-            InitialStateSpec::Outputs => Some("outputs"),
-            _ => Some("recognition"),
-        };
-        if let Some(rule) = rule {
-            notes.push(format!(
-                "the model was trained with the '{rule}' initial-state rule, which needs the \
-                 first outputs; inputs alone are predicted from x_0 = 0 (predict a dataset to \
-                 apply it)"
-            ));
-        }
-    }
+    let notes = inputs_only_notes(model);
     let prediction = model
         .predict_inputs(inputs, particles, prediction_seed(seed, 0))
         .map_err(|e| JobError::Prssm {

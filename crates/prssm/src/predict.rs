@@ -321,25 +321,51 @@ impl Prediction {
     /// # Errors
     /// I/O errors of the atomic write.
     pub fn write_csv(&self, path: &std::path::Path, n_output: usize) -> std::io::Result<()> {
-        use std::io::Write;
-        let t_n = self.output_mean.len() / n_output.max(1);
+        let n = n_output.max(1);
         flapssm_data::atomic::write_atomic(path, |w| {
-            let head: Vec<String> = (0..n_output)
-                .map(|d| format!("mean_{d}"))
-                .chain((0..n_output).map(|d| format!("var_{d}")))
-                .collect();
-            writeln!(w, "step,{}", head.join(","))?;
-            for t in 0..t_n {
-                write!(w, "{t}")?;
-                for v in &self.output_mean[t * n_output..(t + 1) * n_output] {
-                    write!(w, ",{v}")?;
-                }
-                for v in &self.output_var[t * n_output..(t + 1) * n_output] {
-                    write!(w, ",{v}")?;
-                }
-                writeln!(w)?;
+            write_csv_header(w, n_output)?;
+            for (t, (mean, var)) in self
+                .output_mean
+                .chunks_exact(n)
+                .zip(self.output_var.chunks_exact(n))
+                .enumerate()
+            {
+                write_csv_row(w, t, mean, var)?;
             }
             Ok(())
         })
     }
+}
+
+/// The header of a prediction CSV: `step,mean_0..mean_{D_y−1},var_0..var_{D_y−1}`.
+///
+/// # Errors
+/// Errors of `w`.
+pub fn write_csv_header(w: &mut impl std::io::Write, n_output: usize) -> std::io::Result<()> {
+    write!(w, "step")?;
+    for d in 0..n_output {
+        write!(w, ",mean_{d}")?;
+    }
+    for d in 0..n_output {
+        write!(w, ",var_{d}")?;
+    }
+    writeln!(w)
+}
+
+/// One row of a prediction CSV: step `t`, the `D_y` means, the `D_y` variances (shortest
+/// round-trip decimal form). Shared by [`Prediction::write_csv`] and streaming.
+///
+/// # Errors
+/// Errors of `w`.
+pub fn write_csv_row(
+    w: &mut impl std::io::Write,
+    t: usize,
+    mean: &[f64],
+    var: &[f64],
+) -> std::io::Result<()> {
+    write!(w, "{t}")?;
+    for v in mean.iter().chain(var) {
+        write!(w, ",{v}")?;
+    }
+    writeln!(w)
 }

@@ -8,6 +8,7 @@ pub mod model;
 pub mod predict;
 pub mod qs;
 pub mod simulate;
+pub mod stream;
 pub mod sweep;
 pub mod sysid;
 pub mod train;
