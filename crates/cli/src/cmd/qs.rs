@@ -6,10 +6,9 @@ use anyhow::{Context, Result};
 use clap::{Args, Subcommand, ValueEnum};
 use flapssm_jobs::NoProgress;
 use flapssm_jobs::models::Fit;
-use flapssm_jobs::models::lrqsm::{LrqsmFit, predict_file};
+use flapssm_jobs::models::lrqsm::{LrqsmFit, fit_csv as fit_csv_table, predict_file};
 use flapssm_qs::cv::{EnetOptions, FoldLayout, LambdaRule};
 use flapssm_qs::lrqsm::Rmse;
-use flapssm_qs::table::{fit_table, read_csv};
 use flapssm_qs::{InterceptMode, LrqsmModel};
 use flapssm_wing::dataset::{Dataset, ValidDataset};
 use flapssm_wing::features::FeatureSet;
@@ -181,13 +180,12 @@ fn fit(a: FitArgs) -> Result<()> {
 }
 
 fn fit_csv(a: FitCsvArgs) -> Result<()> {
-    let table = read_csv(&a.file)?;
     let opts = EnetOptions {
         standardize: !a.no_standardize,
         intercept: !a.no_intercept,
         ..a.path.options()
     };
-    let model = fit_table(&table, &a.targets, a.features.as_deref(), &opts)
+    let model = fit_csv_table(&a.file, &a.targets, a.features.as_deref(), &opts)
         .with_context(|| format!("fitting on {}", a.file.display()))?;
     finish(&model, &a.out, a.path.json)
 }

@@ -143,3 +143,22 @@ impl Fit for LrqsmFit {
         LrqsmLoadModel::from_cow(Cow::Owned(m))
     }
 }
+
+/// `flapssm qs fit-csv`: an elastic net with cross-validation on the columns of a CSV table
+/// (a header line of names): `targets` on `features` (default: every other column). The model
+/// records the file as its source; it is not a [`LoadModel`] (no wing features).
+///
+/// # Errors
+/// [`JobError::Qs`] naming the file, line and column of a malformed table, an unknown or
+/// ambiguous column, and the fit's errors.
+pub fn fit_csv(
+    path: &Path,
+    targets: &[String],
+    features: Option<&[String]>,
+    options: &EnetOptions,
+) -> Result<LrqsmModel> {
+    let table = flapssm_qs::table::read_csv(path)?;
+    Ok(flapssm_qs::table::fit_table(
+        &table, targets, features, options,
+    )?)
+}
