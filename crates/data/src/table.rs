@@ -175,10 +175,11 @@ impl Table {
         )
     }
 
-    /// Reads a CSV file whose first non-comment line is a header of column names.
+    /// Reads a CSV file whose first non-comment line is a header of unique column names.
     ///
     /// # Errors
-    /// As [`Table::read_ascii`], plus [`TableError::Syntax`].
+    /// As [`Table::read_ascii`], plus [`TableError::Syntax`] for a malformed line or a header
+    /// name given twice (a column selected by name would otherwise be the first of them).
     pub fn read_csv(path: &Path) -> Result<Table, TableError> {
         let text = read_text(path)?;
         let mut lines = text.lines().enumerate().filter(|(_, l)| !is_skipped(l));
@@ -191,6 +192,19 @@ impl Table {
             message,
         };
         let names: Vec<String> = split_csv_line(header).map_err(|m| syntax(hk + 1, m))?;
+        for (j, name) in names.iter().enumerate() {
+            if let Some(i) = names[..j].iter().position(|n| n.trim() == name.trim()) {
+                return Err(syntax(
+                    hk + 1,
+                    format!(
+                        "header name '{}' names columns {} and {}; names must be unique",
+                        name.trim(),
+                        i + 1,
+                        j + 1
+                    ),
+                ));
+            }
+        }
         let mut columns: Vec<Vec<f64>> = vec![Vec::new(); names.len()];
         for (k, line) in lines {
             let fields = split_csv_line(line).map_err(|m| syntax(k + 1, m))?;
@@ -447,6 +461,13 @@ mod tests {
         assert!(e.contains("n.csv: line 3, column 2: 'x'"), "{e}");
         std::fs::write(&p, "a,b\n1,2\n3,nan\n").unwrap();
         assert!(Table::read_csv(&p).is_err());
+        // Regression: a repeated header name used to select the first of its columns twice.
+        std::fs::write(&p, "# c\nx,y, x\n1,2,3\n").unwrap();
+        let e = Table::read_csv(&p).unwrap_err().to_string();
+        assert!(
+            e.contains("n.csv: line 2: header name 'x' names columns 1 and 3"),
+            "{e}"
+        );
         std::fs::write(&p, "a,b\n1,2\n").unwrap();
         let t = Table::read_csv(&p).unwrap();
         let e = t.column(&"c".parse().unwrap()).unwrap_err().to_string();
