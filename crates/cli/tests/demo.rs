@@ -106,16 +106,28 @@ fn tiny_demo_evaluate_and_sweep() {
         dir.join("prssm.json").to_str().unwrap(),
         "--lrqsm",
         dir.join("lrqsm.json").to_str().unwrap(),
+        "--baseline",
+        "arx",
         "--out",
         ev.to_str().unwrap(),
         "--seed",
         "5",
     ]);
     let m2 = json(&ev.join("metrics.json"));
-    // The demo also evaluated the ARX baseline; evaluate was given the PR-SSM and the LRQSM.
-    assert_eq!(m2["models"][0], m["models"][0]);
-    assert_eq!(m2["models"][1], m["models"][1]);
+    // The demo fitted every registered baseline (the ARX model); evaluate was asked for it.
     assert_eq!(m["models"][2]["key"], "arx");
+    assert_eq!(m2["models"], m["models"]);
+    let o = flapssm(&[
+        "evaluate",
+        "--dataset",
+        dir.join("dataset.npz").to_str().unwrap(),
+        "--baseline",
+        "nope",
+        "--out",
+        ev.to_str().unwrap(),
+    ]);
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("unknown baseline; known: arx"));
 
     // `predict` with the same seed draws what `evaluate` and the demo drew (one seed rule).
     let pred = tmp.path().join("pred.npz");

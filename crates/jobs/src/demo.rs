@@ -35,10 +35,9 @@ use crate::evaluate::{
     versions,
 };
 use crate::files::{load_json, save_json};
-use crate::models::arx::{ArxFit, ArxSettings};
 use crate::models::lrqsm::LrqsmLoadModel;
 use crate::models::prssm::PrssmLoadModel;
-use crate::models::{Fit, LoadModel};
+use crate::models::{BASELINES, Baseline, LoadModel, baseline};
 use crate::progress::Progress;
 use crate::simulate::simulate;
 use crate::train::{TrainingOptions, TrainingPlan, train_prssm};
@@ -70,8 +69,9 @@ pub struct DemoConfig {
     pub lrqsm: EnetOptions,
     /// PR-SSM training.
     pub training: TrainingOptions,
-    /// The ARX baseline (fitted in the evaluation stage; least squares, milliseconds).
-    pub arx: ArxSettings,
+    /// Baselines fitted in the evaluation stage beside the PR-SSM and the LRQSM (keys of
+    /// [`BASELINES`]; default: all of them).
+    pub baselines: Vec<String>,
     /// Evaluation.
     pub evaluation: EvalOptions,
 }
@@ -107,7 +107,7 @@ impl DemoConfig {
                 seed,
                 ..TrainingOptions::default()
             },
-            arx: ArxSettings::default(),
+            baselines: all_baselines(),
             evaluation: EvalOptions {
                 seed,
                 ..EvalOptions::default()
@@ -131,7 +131,7 @@ impl DemoConfig {
                 seed,
                 ..TrainingOptions::default()
             },
-            arx: ArxSettings::default(),
+            baselines: all_baselines(),
             evaluation: EvalOptions {
                 seed,
                 ..EvalOptions::default()
@@ -140,7 +140,7 @@ impl DemoConfig {
     }
 
     /// Checks every setting before any work: the wing and its trajectories, the LRQSM's
-    /// elastic net, the PR-SSM training, the ARX baseline and the evaluation.
+    /// elastic net, the PR-SSM training, the baselines' keys and the evaluation.
     ///
     /// # Errors
     /// The first invalid setting, named ([`JobError::Setting`], or the library's own error
@@ -155,7 +155,11 @@ impl DemoConfig {
         self.evaluation.check()?;
         Ok(DemoPlan {
             training: self.training.check()?,
-            arx: self.arx.check()?,
+            baselines: self
+                .baselines
+                .iter()
+                .map(|k| baseline(k))
+                .collect::<Result<_>>()?,
         })
     }
 }
@@ -165,8 +169,13 @@ impl DemoConfig {
 pub struct DemoPlan {
     /// PR-SSM training.
     pub training: TrainingPlan,
-    /// The ARX baseline.
-    pub arx: ArxFit,
+    /// The baselines.
+    pub baselines: Vec<&'static Baseline>,
+}
+
+/// The keys of every registered baseline.
+fn all_baselines() -> Vec<String> {
+    BASELINES.iter().map(|b| b.key.to_string()).collect()
 }
 
 /// Wall time of one stage.
@@ -209,7 +218,7 @@ pub struct DemoSummary {
     pub prssm_cycle_average_ci: Vec<Interval>,
     /// Same for the LRQSM.
     pub lrqsm_cycle_average_ci: Vec<Interval>,
-    /// Further baselines evaluated beside the PR-SSM and the LRQSM (the ARX model).
+    /// Further baselines evaluated beside the PR-SSM and the LRQSM ([`DemoConfig::baselines`]).
     pub baselines: Vec<BaselineSummary>,
     /// AoA and a_x on the output states.
     pub authority: Vec<AuthorityFinding>,
@@ -332,7 +341,7 @@ pub fn run_demo(
     let t_all = Instant::now();
     let DemoPlan {
         training: plan,
-        arx: arx_fit,
+        baselines,
     } = cfg.check()?;
     std::fs::create_dir_all(dir).map_err(|source| JobError::Io {
         path: dir.to_path_buf(),
@@ -447,7 +456,7 @@ pub fn run_demo(
     let metrics_path = eval_dir.join("metrics.json");
     let report_path = eval_dir.join("report.html");
     let k_ev = serde_json::json!({
-        "lrqsm": k_lq, "prssm": k_pm, "arx": json(&cfg.arx),
+        "lrqsm": k_lq, "prssm": k_pm, "baselines": json(&cfg.baselines),
         "evaluation": json(&cfg.evaluation), "metrics_version": METRICS_VERSION,
     });
     let timings_so_far: Vec<(String, String)> = run
@@ -472,15 +481,22 @@ pub fn run_demo(
         |p| {
             let ctx = ReportContext {
                 title: format!("flapssm demo ({} configuration, seed {})", cfg.name, cfg.seed),
-                intro: "Virtual flapping wing simulated with flapssm; PR-SSM, LRQSM (elastic net on quasi-steady features) and an ARX baseline (least squares on lagged inputs) fitted on the training trajectories and evaluated open loop on all trajectories.".into(),
+                intro: format!(
+                    "Virtual flapping wing simulated with flapssm; PR-SSM, LRQSM (elastic net on quasi-steady features){} fitted on the training trajectories and evaluated open loop on all trajectories.",
+                    baselines.iter().map(|b| format!(" and {}", b.about)).collect::<String>()
+                ),
                 headline: timings_so_far,
                 config: json(cfg),
             };
             let e = &cfg.evaluation;
             let prssm = PrssmLoadModel::new(&prssm, &ds, e.particles, e.seed)?;
             let lrqsm = LrqsmLoadModel::new(&lrqsm)?;
-            let arx = arx_fit.fit(&ds, p)?;
-            let models: [&dyn LoadModel; 3] = [&prssm, &lrqsm, &arx];
+            let fitted = baselines
+                .iter()
+                .map(|b| (b.fit)(&ds, p))
+                .collect::<Result<Vec<_>>>()?;
+            let mut models: Vec<&dyn LoadModel> = vec![&prssm, &lrqsm];
+            models.extend(fitted.iter().map(|m| &**m));
             evaluate(
                 &ds,
                 &ds_path.display().to_string(),
@@ -574,7 +590,7 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let out = dir.path().join("demo");
         type Edit = fn(&mut DemoConfig);
-        let cases: [(&str, Edit); 5] = [
+        let cases: [(&str, Edit); 6] = [
             ("n_train", |c| c.simulation.trajectories.n_train = 500),
             ("fluid.kinematic_viscosity_m2_s", |c| {
                 c.simulation.wing.fluid.kinematic_viscosity_m2_s = 0.0
@@ -582,6 +598,9 @@ mod tests {
             ("n_folds", |c| c.lrqsm.n_folds = 1),
             ("epochs", |c| c.training.epochs = Some(0)),
             ("particles", |c| c.evaluation.particles = 0),
+            ("baseline = nope: one of arx", |c| {
+                c.baselines = vec!["nope".into()]
+            }),
         ];
         for (name, edit) in cases {
             let mut cfg = DemoConfig::default_for(1);

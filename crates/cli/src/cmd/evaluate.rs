@@ -5,20 +5,19 @@ use std::path::PathBuf;
 use anyhow::Context;
 use clap::Args;
 use flapssm_jobs::evaluate::{EvalOptions, ReportContext, evaluate};
-use flapssm_jobs::models::arx::ArxSettings;
 use flapssm_jobs::models::lrqsm::LrqsmLoadModel;
 use flapssm_jobs::models::prssm::PrssmLoadModel;
-use flapssm_jobs::models::{Fit, LoadModel};
+use flapssm_jobs::models::{BASELINES, LoadModel, baseline};
 use flapssm_prssm::PrssmModel;
 use flapssm_qs::LrqsmModel;
 use flapssm_wing::dataset::Dataset;
 
 use crate::progress::Bars;
 
-/// Evaluate load models (a PR-SSM, an LRQSM, the ARX baseline) on a dataset's training and
-/// test trajectories.
+/// Evaluate load models (a PR-SSM, an LRQSM, baselines fitted on the spot) on a dataset's
+/// training and test trajectories.
 #[derive(Args)]
-#[command(group(clap::ArgGroup::new("models").required(true).multiple(true).args(["prssm", "lrqsm", "arx"])))]
+#[command(group(clap::ArgGroup::new("models").required(true).multiple(true).args(["prssm", "lrqsm", "baseline"])))]
 pub struct EvaluateArgs {
     /// Dataset file (flapssm .npz) with outputs.
     #[arg(long)]
@@ -29,10 +28,10 @@ pub struct EvaluateArgs {
     /// LRQSM model file (.json, from `flapssm qs fit`).
     #[arg(long)]
     lrqsm: Option<PathBuf>,
-    /// Also fit and evaluate the ARX baseline (least squares on 21 lags of the inputs, 2 samples
-    /// apart) on the dataset's training trajectories.
-    #[arg(long)]
-    arx: bool,
+    /// Also fit this baseline on the dataset's training trajectories and evaluate it
+    /// (repeatable; `arx`: least squares on 21 lags of the inputs, 2 samples apart).
+    #[arg(long, value_name = "KEY", value_parser = baseline_key)]
+    baseline: Vec<String>,
     /// Output folder.
     #[arg(long)]
     out: PathBuf,
@@ -56,7 +55,6 @@ pub fn run(a: EvaluateArgs) -> anyhow::Result<()> {
         ..EvalOptions::default()
     };
     opts.check()?;
-    let arx_fit = a.arx.then(|| ArxSettings::default().check()).transpose()?;
     let ds = Dataset::load(&a.dataset)
         .with_context(|| format!("loading dataset {}", a.dataset.display()))?;
     let prssm = a
@@ -84,10 +82,15 @@ pub fn run(a: EvaluateArgs) -> anyhow::Result<()> {
         .transpose()
         .with_context(|| format!("LRQSM on {}", a.dataset.display()))?;
     let bars = Bars::new();
-    let arx = arx_fit
-        .map(|f| f.fit(&ds, &bars))
-        .transpose()
-        .with_context(|| format!("fitting the ARX baseline on {}", a.dataset.display()))?;
+    let baselines = a
+        .baseline
+        .iter()
+        .map(|k| {
+            let b = baseline(k)?;
+            (b.fit)(&ds, &bars)
+                .with_context(|| format!("fitting the {k} baseline on {}", a.dataset.display()))
+        })
+        .collect::<anyhow::Result<Vec<_>>>()?;
     let mut models: Vec<&dyn LoadModel> = Vec::new();
     if let Some(m) = &prssm {
         models.push(m);
@@ -95,9 +98,7 @@ pub fn run(a: EvaluateArgs) -> anyhow::Result<()> {
     if let Some(m) = &lrqsm {
         models.push(m);
     }
-    if let Some(m) = &arx {
-        models.push(m);
-    }
+    models.extend(baselines.iter().map(|m| &**m));
     let ctx = ReportContext {
         intro: format!(
             "{} evaluated on {}.",
@@ -109,7 +110,7 @@ pub fn run(a: EvaluateArgs) -> anyhow::Result<()> {
             a.dataset.display()
         ),
         config: serde_json::json!({
-            "dataset": a.dataset, "prssm": a.prssm, "lrqsm": a.lrqsm, "arx": a.arx,
+            "dataset": a.dataset, "prssm": a.prssm, "lrqsm": a.lrqsm, "baselines": a.baseline,
         }),
         ..ReportContext::default()
     };
@@ -152,4 +153,19 @@ pub fn run(a: EvaluateArgs) -> anyhow::Result<()> {
         a.out.display()
     );
     Ok(())
+}
+
+/// A registered baseline's key (`--baseline`).
+fn baseline_key(key: &str) -> Result<String, String> {
+    match BASELINES.iter().find(|b| b.key == key) {
+        Some(b) => Ok(b.key.to_string()),
+        None => Err(format!(
+            "unknown baseline; known: {}",
+            BASELINES
+                .iter()
+                .map(|b| b.key)
+                .collect::<Vec<_>>()
+                .join(", ")
+        )),
+    }
 }

@@ -18,12 +18,19 @@ use faer::{Mat, Side};
 use flapssm_wing::dataset::{Trajectory, ValidDataset};
 use serde::{Deserialize, Serialize};
 
-use super::{Fit, LoadModel, LoadPrediction, check_buffer};
+use super::{Baseline, Fit, LoadModel, LoadPrediction, check_buffer};
 use crate::error::{JobError, Result};
 use crate::progress::Progress;
 
 const N_INPUT: usize = 7;
 const N_OUTPUT: usize = 5;
+
+/// The registry entry ([`super::BASELINES`]): ARX with [`ArxSettings::default`].
+pub const BASELINE: Baseline = Baseline {
+    key: "arx",
+    about: "ARX: least squares on 21 lags of the standardized inputs, 2 samples apart",
+    fit: |ds, progress| Ok(Box::new(ArxSettings::default().check()?.fit(ds, progress)?)),
+};
 
 /// Settings of the ARX baseline.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]

@@ -1,14 +1,16 @@
 //! Load models: wing kinematics in, the five loads out, one trajectory at a time.
 //!
 //! [`LoadModel`] is what evaluation, the report and the demo's summary need of a model; [`Fit`]
-//! turns validated settings into one (linfa's `Fit`). Evaluation takes any number of models,
-//! so a new baseline is one new file implementing both.
+//! turns validated settings into one (linfa's `Fit`). Evaluation takes any number of models.
+//! A baseline fitted from the data with default settings is a [`Baseline`]: a new one is a new
+//! file here and its line in [`BASELINES`]; `flapssm evaluate --baseline KEY` and the demo then
+//! fit, evaluate, tabulate and report it with no other change.
 //!
 //! | model | file | fitted by |
 //! |---|---|---|
 //! | PR-SSM | [`prssm`] | particle ELBO with Adam ([`crate::train`]) |
 //! | LRQSM | [`lrqsm`] | elastic net with cross-validation (`flapssm-qs`) |
-//! | ARX | [`arx`] | least squares on lagged inputs |
+//! | ARX (a [`Baseline`]) | [`arx`] | least squares on lagged inputs |
 
 use flapssm_prssm::train::EpochRecord;
 use flapssm_wing::dataset::{Trajectory, ValidDataset};
@@ -76,6 +78,55 @@ pub trait Fit {
     /// # Errors
     /// The model's fitting errors, naming the dataset or trajectory.
     fn fit(&self, ds: &ValidDataset, progress: &dyn Progress) -> Result<Self::Model>;
+}
+
+/// A baseline fitted on a dataset's training trajectories with its default settings (see the
+/// module docs).
+#[derive(Clone, Copy)]
+pub struct Baseline {
+    /// Its [`LoadModel::key`], the value of `--baseline`.
+    pub key: &'static str,
+    /// One line for `--help` and the report.
+    pub about: &'static str,
+    /// Fits it on `ds`'s training trajectories.
+    pub fit: fn(ds: &ValidDataset, progress: &dyn Progress) -> Result<Box<dyn LoadModel>>,
+}
+
+impl PartialEq for Baseline {
+    fn eq(&self, other: &Self) -> bool {
+        self.key == other.key
+    }
+}
+
+impl std::fmt::Debug for Baseline {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Baseline").field("key", &self.key).finish()
+    }
+}
+
+/// Every registered baseline.
+pub const BASELINES: &[Baseline] = &[arx::BASELINE];
+
+/// The registered baseline `key`.
+///
+/// # Errors
+/// [`JobError::Setting`] naming the known keys.
+pub fn baseline(key: &str) -> Result<&'static Baseline> {
+    BASELINES
+        .iter()
+        .find(|b| b.key == key)
+        .ok_or_else(|| JobError::Setting {
+            name: "baseline".into(),
+            value: key.into(),
+            expected: format!(
+                "one of {}",
+                BASELINES
+                    .iter()
+                    .map(|b| b.key)
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+        })
 }
 
 /// One model's open-loop prediction of one trajectory (owned tables of [`LoadPrediction`]).
