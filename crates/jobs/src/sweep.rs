@@ -17,12 +17,11 @@ use flapssm_wing::dataset::{OUTPUT_NAMES, ValidDataset};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{JobError, Result};
+use crate::evaluate::prepared::pooled_errors;
 use crate::files::save_json;
 use crate::predict::predict_prssm;
 use crate::progress::Progress;
 use crate::train::{TrainingOptions, TrainingPlan, train_prssm};
-use flapssm_analysis::metrics::PooledErrors;
-use flapssm_analysis::stats::Rows;
 
 /// Format tag of a sweep result file.
 pub const RESULT_FORMAT: &str = "flapssm-sweep-result";
@@ -236,39 +235,24 @@ pub fn sweep_run(
     let sub = ds.with_training_prefix(used)?;
     let pred = predict_prssm(&out.best, &sub, particles, seed, progress)?;
     progress.finish("");
-    let z = |y: &[f64]| -> Vec<f64> {
-        y.chunks_exact(5)
-            .flat_map(|r| (0..5).map(move |j| (r[j] - stats.mean_y[j]) / stats.std_y[j]))
-            .collect()
-    };
     let meas: Vec<Vec<f64>> = sub
         .trajectories
         .iter()
-        .map(|t| z(t.outputs.as_deref().unwrap_or_default().as_flattened()))
+        .map(|t| stats.normalize_y_table(t.outputs.as_deref().unwrap_or_default().as_flattened()))
         .collect();
-    let predz: Vec<Vec<f64>> = pred.iter().map(|p| z(&p.output_mean)).collect();
+    let predz: Vec<Vec<f64>> = pred
+        .iter()
+        .map(|p| stats.normalize_y_table(&p.output_mean))
+        .collect();
     let set = |r: std::ops::Range<usize>| -> Result<Option<SetRmse>> {
         if r.is_empty() {
             return Ok(None);
         }
-        fn rows(v: &[Vec<f64>]) -> Result<Vec<Rows<'_>>> {
-            v.iter()
-                .map(|x| Rows::new(x, 5))
-                .collect::<std::result::Result<_, _>>()
-                .map_err(|source| JobError::Analysis {
-                    what: "sweep errors".into(),
-                    source,
-                })
-        }
-        let e = PooledErrors::new(
-            &rows(&meas[r.clone()])?,
-            &rows(&predz[r.clone()])?,
-            start_sample,
-        )
-        .map_err(|source| JobError::Analysis {
-            what: "sweep errors".into(),
-            source,
-        })?;
+        let tables = meas[r.clone()]
+            .iter()
+            .zip(&predz[r.clone()])
+            .map(|(m, q)| (&m[..], &q[..]));
+        let e = pooled_errors(tables, start_sample)?;
         Ok(Some(SetRmse {
             n_trajectories: r.len(),
             rmse_standardized: e.rmse(),

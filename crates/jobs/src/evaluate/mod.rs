@@ -42,7 +42,7 @@ use crate::progress::Progress;
 
 mod figures;
 mod html;
-mod prepared;
+pub(crate) mod prepared;
 mod tables;
 
 use figures::{draw_fig3, draw_training, example_title, example_trajectories};
@@ -420,11 +420,7 @@ fn check(ds: &ValidDataset, models: &[&dyn LoadModel], opts: &EvalOptions) -> Re
 fn prepare(ds: &ValidDataset, predictions: &[Vec<ModelPrediction>]) -> Result<Vec<Prepared>> {
     let stats = ds.standardization()?;
     let (fluid, wing) = (&ds.meta.fluid, &ds.meta.wing);
-    let z = |y: &[f64]| -> Vec<f64> {
-        y.chunks_exact(5)
-            .flat_map(|r| (0..5).map(move |j| (r[j] - stats.mean_y[j]) / stats.std_y[j]))
-            .collect()
-    };
+    let z = |y: &[f64]| stats.normalize_y_table(y);
     let mut prep = Vec::with_capacity(ds.len());
     for (i, t) in ds.trajectories.iter().enumerate() {
         let what = format!("trajectory {i}");

@@ -65,14 +65,23 @@ pub(super) fn split_metrics(
 
 /// Standardized errors of model `k` on a set, pooled from sample `start` on.
 pub(super) fn pooled(prep: &[&Prepared], k: usize, start: usize) -> Result<PooledErrors> {
-    let m: Vec<Rows<'_>> = prep
-        .iter()
-        .map(|p| rows(&p.measured_z, 5, "errors"))
-        .collect::<Result<_>>()?;
-    let q: Vec<Rows<'_>> = prep
-        .iter()
-        .map(|p| rows(&p.models[k].z, 5, "errors"))
-        .collect::<Result<_>>()?;
+    pooled_errors(
+        prep.iter().map(|p| (&p.measured_z[..], &p.models[k].z[..])),
+        start,
+    )
+}
+
+/// Errors of (measured, predicted) `n × 5` tables of a set of trajectories, pooled from sample
+/// `start` on.
+pub(crate) fn pooled_errors<'a>(
+    tables: impl Iterator<Item = (&'a [f64], &'a [f64])>,
+    start: usize,
+) -> Result<PooledErrors> {
+    let (m, q): (Vec<Rows<'_>>, Vec<Rows<'_>>) = tables
+        .map(|(m, q)| Ok((rows(m, 5, "errors")?, rows(q, 5, "errors")?)))
+        .collect::<Result<Vec<_>>>()?
+        .into_iter()
+        .unzip();
     PooledErrors::new(&m, &q, start).map_err(analysis("pooled errors"))
 }
 

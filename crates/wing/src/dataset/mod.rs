@@ -274,6 +274,12 @@ impl Standardization {
     pub fn normalize_y(&self, y: &[f64; 5]) -> [f64; 5] {
         std::array::from_fn(|j| (y[j] - self.mean_y[j]) / self.std_y[j])
     }
+    /// z-scores a row-major `n × 5` table of outputs (a trailing partial row is dropped).
+    pub fn normalize_y_table(&self, y: &[f64]) -> Vec<f64> {
+        y.chunks_exact(5)
+            .flat_map(|r| (0..5).map(move |j| (r[j] - self.mean_y[j]) / self.std_y[j]))
+            .collect()
+    }
     /// Inverse of [`Self::normalize_y`]: `ȳ + σ_y z`.
     pub fn denormalize_y(&self, z: &[f64; 5]) -> [f64; 5] {
         std::array::from_fn(|j| self.mean_y[j] + self.std_y[j] * z[j])
