@@ -127,7 +127,7 @@ fn tiny_demo_evaluate_and_sweep() {
         ev.to_str().unwrap(),
     ]);
     assert!(!o.status.success());
-    assert!(String::from_utf8_lossy(&o.stderr).contains("unknown baseline; known: arx"));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("baseline = nope: one of arx"));
 
     // `predict` with the same seed draws what `evaluate` and the demo drew (one seed rule).
     let pred = tmp.path().join("pred.npz");

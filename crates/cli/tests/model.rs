@@ -162,10 +162,9 @@ fn malformed_parameter_file_is_refused_naming_the_missing_array() {
     assert!(out.exists());
 }
 
-#[test]
-fn wrong_input_width_is_refused_naming_the_csv() {
-    let dir = tempfile::tempdir().unwrap();
-    let model = dir.path().join("published.json");
+/// The published model imported into `dir/published.json`.
+fn import_published(dir: &Path) -> std::path::PathBuf {
+    let model = dir.join("published.json");
     ok(&[
         "model",
         "import-published",
@@ -173,6 +172,13 @@ fn wrong_input_width_is_refused_naming_the_csv() {
         "--out",
         s(&model),
     ]);
+    model
+}
+
+#[test]
+fn wrong_input_width_is_refused_naming_the_csv() {
+    let dir = tempfile::tempdir().unwrap();
+    let model = import_published(dir.path());
     let csv = dir.path().join("six.csv");
     std::fs::write(&csv, "a,b,c,d,e,f\n0,0,0,0,0,0\n1,1,1,1,1,1\n").unwrap();
     let out = dir.path().join("pred.csv");
@@ -201,14 +207,7 @@ fn stream(args: &[&str], stdin: &[u8]) -> std::process::Output {
 #[test]
 fn streaming_the_published_inputs_equals_the_batch_prediction() {
     let dir = tempfile::tempdir().unwrap();
-    let model = dir.path().join("published.json");
-    ok(&[
-        "model",
-        "import-published",
-        s(&reference_npz()),
-        "--out",
-        s(&model),
-    ]);
+    let model = import_published(dir.path());
     let inputs = dir.path().join("u_in.csv");
     write_inputs(&mut NpzReader::open(reference_npz()).unwrap(), &inputs);
     let batch = dir.path().join("batch.csv");

@@ -7,7 +7,7 @@ use clap::Args;
 use flapssm_jobs::evaluate::{EvalOptions, ReportContext, evaluate};
 use flapssm_jobs::models::lrqsm::LrqsmLoadModel;
 use flapssm_jobs::models::prssm::PrssmLoadModel;
-use flapssm_jobs::models::{BASELINES, LoadModel, baseline};
+use flapssm_jobs::models::{LoadModel, baseline};
 use flapssm_prssm::PrssmModel;
 use flapssm_qs::LrqsmModel;
 use flapssm_wing::dataset::Dataset;
@@ -157,15 +157,7 @@ pub fn run(a: EvaluateArgs) -> anyhow::Result<()> {
 
 /// A registered baseline's key (`--baseline`).
 fn baseline_key(key: &str) -> Result<String, String> {
-    match BASELINES.iter().find(|b| b.key == key) {
-        Some(b) => Ok(b.key.to_string()),
-        None => Err(format!(
-            "unknown baseline; known: {}",
-            BASELINES
-                .iter()
-                .map(|b| b.key)
-                .collect::<Vec<_>>()
-                .join(", ")
-        )),
-    }
+    baseline(key)
+        .map(|b| b.key.to_string())
+        .map_err(|e| e.to_string())
 }
