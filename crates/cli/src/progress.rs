@@ -95,11 +95,13 @@ impl Progress for Bars {
     }
 }
 
-/// A stop flag set by Ctrl-C.
+/// A stop flag set by Ctrl-C (SIGINT) and, on Unix, by SIGTERM and SIGHUP (what `timeout`,
+/// job schedulers and a closed terminal send): training then writes its checkpoint and the
+/// command exits nonzero, resumable.
 pub fn stop_flag() -> anyhow::Result<Arc<AtomicBool>> {
     let stop = Arc::new(AtomicBool::new(false));
     let s = Arc::clone(&stop);
     ctrlc::set_handler(move || s.store(true, Ordering::SeqCst))
-        .context("installing the Ctrl-C handler")?;
+        .context("installing the Ctrl-C / SIGTERM handler")?;
     Ok(stop)
 }

@@ -88,6 +88,9 @@ pub enum JobError {
         /// Cause.
         source: std::io::Error,
     },
+    /// An output path that cannot or must not be written (refused before any work).
+    #[error("output {0}")]
+    Output(std::io::Error),
     /// A line of a text input is malformed (line 0: the input as a whole).
     #[error("{path} line {line}: {message}")]
     Parse {
@@ -107,13 +110,20 @@ pub enum JobError {
         source: serde_json::Error,
     },
     /// Stopped on request; the training checkpoint allows resuming.
-    #[error("interrupted at step {step}; rerun the same command to resume from {checkpoint}")]
+    #[error("interrupted at step {step}{}", resume_note(checkpoint.as_deref()))]
     Interrupted {
         /// Optimizer steps done.
         step: u64,
-        /// Checkpoint file.
-        checkpoint: PathBuf,
+        /// Checkpoint file, for a run that writes one.
+        checkpoint: Option<PathBuf>,
     },
+}
+
+fn resume_note(checkpoint: Option<&std::path::Path>) -> String {
+    match checkpoint {
+        Some(c) => format!("; checkpoint {} written to resume from", c.display()),
+        None => "; nothing was written".into(),
+    }
 }
 
 /// Result alias of the pipeline.

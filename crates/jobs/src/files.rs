@@ -46,3 +46,125 @@ pub fn load_json<T: serde::de::DeserializeOwned>(path: &Path) -> Result<T> {
         source,
     })
 }
+
+/// Checks, before any work, that every output file can be written
+/// ([`flapssm_data::atomic::check_output`]: not `-`, a directory, a device or a dangling link;
+/// its directory exists and is writable) and that none is one of the inputs, whatever the name
+/// it is given by (`./x`, a symbolic or hard link), nor another output.
+///
+/// # Errors
+/// [`JobError::Output`] naming the output and, for a clash, the input.
+pub fn check_outputs(outputs: &[&Path], inputs: &[&Path]) -> Result<()> {
+    for (k, out) in outputs.iter().enumerate() {
+        flapssm_data::atomic::check_output(out).map_err(JobError::Output)?;
+        let clash = |other: &Path, what: &str| {
+            JobError::Output(std::io::Error::new(
+                std::io::ErrorKind::InvalidInput,
+                format!(
+                    "{}: is the {what} {}; writing it would destroy it",
+                    out.display(),
+                    other.display()
+                ),
+            ))
+        };
+        if let Some(input) = inputs.iter().find(|i| same_file(out, i)) {
+            return Err(clash(input, "input"));
+        }
+        if let Some(other) = outputs[..k].iter().find(|o| same_file(out, o)) {
+            return Err(clash(other, "output"));
+        }
+    }
+    Ok(())
+}
+
+/// [`check_outputs`] for a figure, whose extension must also name a format (`.png`, `.svg`).
+///
+/// # Errors
+/// [`JobError::Analysis`] for another extension; [`check_outputs`]' errors.
+pub fn check_figure_output(path: &Path, inputs: &[&Path]) -> Result<()> {
+    flapssm_analysis::plots::Format::from_path(path).map_err(|source| JobError::Analysis {
+        what: "figure".into(),
+        source,
+    })?;
+    check_outputs(&[path], inputs)
+}
+
+/// Checks, before any work, that `dir` can be an output directory: an existing directory or a
+/// new name in an existing one.
+///
+/// # Errors
+/// [`JobError::Output`] for an existing non-directory or a missing parent.
+pub fn check_output_dir(dir: &Path) -> Result<()> {
+    let refuse = |why: String| {
+        Err(JobError::Output(std::io::Error::new(
+            std::io::ErrorKind::InvalidInput,
+            format!("{}: {why}", dir.display()),
+        )))
+    };
+    match std::fs::metadata(dir) {
+        Ok(m) if m.is_dir() => Ok(()),
+        Ok(_) => refuse("exists and is not a directory".into()),
+        Err(_) => match dir.parent().filter(|p| !p.as_os_str().is_empty()) {
+            Some(p) if !p.is_dir() => refuse(format!("directory {} does not exist", p.display())),
+            _ => Ok(()),
+        },
+    }
+}
+
+/// Whether `a` and `b` name the same existing file (same device and inode on Unix, same
+/// canonical path elsewhere); a path that does not exist is no other file.
+fn same_file(a: &Path, b: &Path) -> bool {
+    let (Ok(ma), Ok(mb)) = (std::fs::metadata(a), std::fs::metadata(b)) else {
+        return false;
+    };
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::MetadataExt;
+        (ma.dev(), ma.ino()) == (mb.dev(), mb.ino())
+    }
+    #[cfg(not(unix))]
+    {
+        let _ = (ma, mb);
+        std::fs::canonicalize(a).ok() == std::fs::canonicalize(b).ok()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_output_that_is_an_input_is_refused_by_any_name() {
+        let dir = tempfile::tempdir().unwrap();
+        let d = dir.path();
+        let input = d.join("wing.npz");
+        std::fs::write(&input, b"data").unwrap();
+        let dotted = d.join(".").join("wing.npz");
+        let e = check_outputs(&[&dotted], &[&input])
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("is the input") && e.contains("wing.npz"), "{e}");
+        #[cfg(unix)]
+        {
+            let link = d.join("link.npz");
+            std::os::unix::fs::symlink(&input, &link).unwrap();
+            assert!(check_outputs(&[&link], &[&input]).is_err());
+            let hard = d.join("hard.npz");
+            std::fs::hard_link(&input, &hard).unwrap();
+            assert!(check_outputs(&[&hard], &[&input]).is_err());
+        }
+        let out = d.join("out.json");
+        std::fs::write(&out, b"{}").unwrap();
+        let e = check_outputs(&[&out, &out], &[&input])
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("is the output"), "{e}");
+        assert!(check_outputs(&[&out, &d.join("new.json")], &[&input]).is_ok());
+        assert_eq!(std::fs::read(&input).unwrap(), b"data");
+
+        assert!(check_output_dir(d).is_ok());
+        assert!(check_output_dir(&d.join("new")).is_ok());
+        assert!(check_output_dir(&input).is_err());
+        assert!(check_output_dir(&d.join("no/such")).is_err());
+    }
+}

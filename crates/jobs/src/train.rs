@@ -306,7 +306,7 @@ pub fn train_prssm(
     if out.outcome.interrupted {
         return Err(JobError::Interrupted {
             step: out.outcome.state.step,
-            checkpoint: checkpoint.map(Path::to_path_buf).unwrap_or_default(),
+            checkpoint: checkpoint.map(Path::to_path_buf),
         });
     }
     Ok(out)

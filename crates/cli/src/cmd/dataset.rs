@@ -1,9 +1,10 @@
 //! `flapssm dataset …`: inspect, export and import dataset files.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
 use clap::{Args, Subcommand};
+use flapssm_jobs::files::check_outputs;
 use flapssm_wing::cycles::{U_REF_RADIUS_M, published_u_ref};
 use flapssm_wing::dataset::Dataset;
 use flapssm_wing::dataset::published::import_published_mat;
@@ -57,6 +58,7 @@ pub fn run(args: DatasetArgs) -> anyhow::Result<()> {
             println!("{}", ds.summary());
         }
         DatasetCommand::Export { file, csv } => {
+            check_outputs(&[&csv], &[&file])?;
             let ds = Dataset::load(&file)
                 .with_context(|| format!("reading dataset {}", file.display()))?;
             ds.export_csv(&csv)
@@ -74,6 +76,8 @@ pub fn run(args: DatasetArgs) -> anyhow::Result<()> {
             out,
             n_train,
         } => {
+            let inputs: Vec<&Path> = mat.iter().chain(&csv).map(PathBuf::as_path).collect();
+            check_outputs(&[&out], &inputs)?;
             let ds = match (mat, csv) {
                 (Some(mat), None) => import_published_mat(&mat, n_train, |euler, dt_s| {
                     published_u_ref(euler, dt_s, U_REF_RADIUS_M)

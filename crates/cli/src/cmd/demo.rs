@@ -4,6 +4,7 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 use clap::Args;
+use flapssm_jobs::JobError;
 use flapssm_jobs::demo::{DemoConfig, run_demo};
 
 use crate::progress::{Bars, stop_flag};
@@ -44,6 +45,7 @@ pub struct DemoArgs {
 
 /// Runs `flapssm demo`.
 pub fn run(args: DemoArgs) -> anyhow::Result<()> {
+    flapssm_jobs::files::check_output_dir(&args.out)?;
     let mut cfg = if args.full {
         DemoConfig::full(args.seed)
     } else {
@@ -72,6 +74,12 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
     let stop = stop_flag()?;
     let bars = Bars::new();
     let s = run_demo(&args.out, &cfg, &bars, Some(&stop))
+        .map_err(|e| match e {
+            JobError::Interrupted { .. } => {
+                anyhow::anyhow!("{e}; rerun the same command to resume")
+            }
+            e => e.into(),
+        })
         .with_context(|| format!("demo in {}", args.out.display()))?;
     let f = |v: &[f64]| {
         v.iter()

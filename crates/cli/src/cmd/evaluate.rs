@@ -48,6 +48,7 @@ pub struct EvaluateArgs {
 
 /// Runs `flapssm evaluate`.
 pub fn run(a: EvaluateArgs) -> anyhow::Result<()> {
+    flapssm_jobs::files::check_output_dir(&a.out)?;
     let opts = EvalOptions {
         particles: a.particles,
         seed: a.seed,

@@ -30,6 +30,7 @@ enum ModelCommand {
 pub fn run(args: ModelArgs) -> anyhow::Result<()> {
     match args.command {
         ModelCommand::ImportPublished { file, out } => {
+            flapssm_jobs::files::check_outputs(&[&out], &[&file])?;
             let model =
                 import_published(&file).with_context(|| format!("importing {}", file.display()))?;
             model

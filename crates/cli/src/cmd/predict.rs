@@ -38,6 +38,16 @@ pub struct PredictArgs {
 
 /// Runs `flapssm predict`.
 pub fn run(args: PredictArgs) -> anyhow::Result<()> {
+    let inputs: Vec<&std::path::Path> = [
+        Some(&args.model),
+        args.dataset.as_ref(),
+        args.inputs.as_ref(),
+    ]
+    .into_iter()
+    .flatten()
+    .map(PathBuf::as_path)
+    .collect();
+    flapssm_jobs::files::check_outputs(&[&args.out], &inputs)?;
     let model = PrssmModel::load(&args.model)
         .with_context(|| format!("loading model {}", args.model.display()))?;
     if let Some(inputs_path) = &args.inputs {

@@ -5,6 +5,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 use clap::{Args, Subcommand, ValueEnum};
 use flapssm_jobs::NoProgress;
+use flapssm_jobs::files::check_outputs;
 use flapssm_jobs::models::Fit;
 use flapssm_jobs::models::lrqsm::{LrqsmFit, fit_csv as fit_csv_table, predict_file};
 use flapssm_qs::cv::{EnetOptions, FoldLayout, LambdaRule};
@@ -164,6 +165,7 @@ fn load_dataset(path: &Path) -> Result<ValidDataset> {
 }
 
 fn fit(a: FitArgs) -> Result<()> {
+    check_outputs(&[&a.out], &[&a.dataset])?;
     let ds = load_dataset(&a.dataset)?;
     let fit = LrqsmFit {
         features: match a.features {
@@ -180,6 +182,7 @@ fn fit(a: FitArgs) -> Result<()> {
 }
 
 fn fit_csv(a: FitCsvArgs) -> Result<()> {
+    check_outputs(&[&a.out], &[&a.file])?;
     let opts = EnetOptions {
         standardize: !a.no_standardize,
         intercept: !a.no_intercept,
@@ -257,6 +260,7 @@ fn finish(model: &LrqsmModel, out: &Path, json: bool) -> Result<()> {
 }
 
 fn predict(a: PredictArgs) -> Result<()> {
+    check_outputs(&[&a.out], &[&a.model, &a.dataset])?;
     let model = LrqsmModel::load(&a.model)
         .with_context(|| format!("loading LRQSM model {}", a.model.display()))?;
     let ds = load_dataset(&a.dataset)?;

@@ -43,6 +43,7 @@ pub struct SimulateArgs {
 /// Runs `flapssm simulate`.
 pub fn run(args: SimulateArgs) -> anyhow::Result<()> {
     let start = Instant::now();
+    flapssm_jobs::files::check_outputs(&[&args.out], &[])?;
     let fidelity: Fidelity = args.fidelity.parse().context("parsing --fidelity")?;
     let cfg = SimulateSettings {
         n_trajectories: args.n,

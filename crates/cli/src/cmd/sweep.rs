@@ -4,6 +4,7 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 use clap::{Args, Subcommand};
+use flapssm_jobs::files::check_outputs;
 use flapssm_jobs::files::save_json;
 use flapssm_jobs::sweep::{SweepKind, SweepSettings, SweepTable, load_result, sweep_run};
 use flapssm_jobs::train::TrainingOptions;
@@ -95,6 +96,7 @@ pub fn run(cmd: SweepCommand) -> anyhow::Result<()> {
 }
 
 fn run_one(a: RunArgs) -> anyhow::Result<()> {
+    check_outputs(&[&a.out], &[&a.dataset])?;
     let ds = Dataset::load(&a.dataset)
         .with_context(|| format!("loading dataset {}", a.dataset.display()))?;
     let training = TrainingOptions {
@@ -153,6 +155,9 @@ fn run_one(a: RunArgs) -> anyhow::Result<()> {
 }
 
 fn merge(a: MergeArgs) -> anyhow::Result<()> {
+    let (json, png) = (a.out.with_extension("json"), a.out.with_extension("png"));
+    let inputs: Vec<&std::path::Path> = a.results.iter().map(PathBuf::as_path).collect();
+    check_outputs(&[&a.out, &json, &png], &inputs)?;
     let results = a
         .results
         .iter()

@@ -104,6 +104,9 @@ fn print_run(r: &SeedRun) {
 
 /// Runs `flapssm sysid`.
 pub fn run(args: SysidArgs) -> anyhow::Result<()> {
+    if let Some(plot) = &args.plot {
+        flapssm_jobs::files::check_figure_output(plot, &[&args.file])?;
+    }
     let record = IoRecord::read(&args.file, &args.inputs, &args.outputs)
         .with_context(|| format!("reading {}", args.file.display()))?;
     let mut spec = SysidSpec {

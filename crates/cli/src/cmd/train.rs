@@ -4,6 +4,7 @@ use std::path::PathBuf;
 
 use anyhow::{Context, bail};
 use clap::Args;
+use flapssm_jobs::JobError;
 use flapssm_jobs::train::{TrainFiles, TrainingOptions, train_dataset};
 use flapssm_prssm::train::LrSchedule;
 use flapssm_prssm::train::fit::Preset;
@@ -109,14 +110,24 @@ pub fn run(args: TrainArgs) -> anyhow::Result<()> {
         checkpoint_every: args.checkpoint_every,
     }
     .check()?;
+    let files = TrainFiles::beside(&args.out, args.checkpoint.clone());
+    flapssm_jobs::files::check_outputs(
+        &[&files.model, &files.last, &files.checkpoint],
+        &[&args.dataset],
+    )?;
     let ds = Dataset::load(&args.dataset)
         .with_context(|| format!("loading dataset {}", args.dataset.display()))?;
     if ds.has_outputs() {
         println!("{}: {}", args.dataset.display(), plan.describe(ds.train())?);
     }
-    let files = TrainFiles::beside(&args.out, args.checkpoint.clone());
     let stop = stop_flag()?;
     let s = train_dataset(&ds, &plan, &files, args.resume, &Bars::new(), Some(&stop))
+        .map_err(|e| match e {
+            JobError::Interrupted { .. } => {
+                anyhow::anyhow!("{e}; rerun the same command with --resume to continue")
+            }
+            e => e.into(),
+        })
         .with_context(|| format!("training on {}", args.dataset.display()))?;
     println!(
         "{} steps ({} rejected); best model (epoch {}, score {}) -> {}; last -> {}",

@@ -27,6 +27,7 @@ pub struct TrajectoriesArgs {
 /// Runs `flapssm trajectories`.
 pub fn run(args: TrajectoriesArgs) -> anyhow::Result<()> {
     let start = Instant::now();
+    flapssm_jobs::files::check_outputs(&[&args.out], &[])?;
     let cfg = GeneratorConfig {
         n_trajectories: args.n,
         n_train: args.n_train.unwrap_or_else(|| default_n_train(args.n)),
