@@ -127,10 +127,15 @@ pub struct Table {
     pub columns: Vec<Vec<f64>>,
 }
 
+/// The file's text, without a leading UTF-8 byte-order mark (spreadsheet exports write one).
 fn read_text(path: &Path) -> Result<String, TableError> {
-    std::fs::read_to_string(path).map_err(|error| TableError::Io {
+    let text = std::fs::read_to_string(path).map_err(|error| TableError::Io {
         path: path.to_path_buf(),
         error,
+    })?;
+    Ok(match text.strip_prefix('\u{feff}') {
+        Some(rest) => rest.to_string(),
+        None => text,
     })
 }
 
@@ -175,11 +180,13 @@ impl Table {
         )
     }
 
-    /// Reads a CSV file whose first non-comment line is a header of unique column names.
+    /// Reads a CSV file whose first non-comment line is a header of unique column names (a
+    /// leading UTF-8 byte-order mark is skipped).
     ///
     /// # Errors
-    /// As [`Table::read_ascii`], plus [`TableError::Syntax`] for a malformed line or a header
-    /// name given twice (a column selected by name would otherwise be the first of them).
+    /// As [`Table::read_ascii`], plus [`TableError::Syntax`] for a malformed line, a header
+    /// name given twice (a column selected by name would otherwise be the first of them) or a
+    /// first line of numbers (it would otherwise be taken as names and the row lost).
     pub fn read_csv(path: &Path) -> Result<Table, TableError> {
         let text = read_text(path)?;
         let mut lines = text.lines().enumerate().filter(|(_, l)| !is_skipped(l));
@@ -192,6 +199,14 @@ impl Table {
             message,
         };
         let names: Vec<String> = split_csv_line(header).map_err(|m| syntax(hk + 1, m))?;
+        if names.iter().all(|n| n.trim().parse::<f64>().is_ok()) {
+            return Err(syntax(
+                hk + 1,
+                "the first line holds numbers, not column names: a CSV needs a header line \
+                 (plain numbers: a whitespace-separated file with another extension)"
+                    .into(),
+            ));
+        }
         for (j, name) in names.iter().enumerate() {
             if let Some(i) = names[..j].iter().position(|n| n.trim() == name.trim()) {
                 return Err(syntax(
@@ -249,6 +264,15 @@ impl Table {
                     "{rows} rows, but column '{}' has {}",
                     names[0],
                     first.len()
+                )));
+            }
+            if let Some(k) = v.data.iter().position(|x| !x.is_finite()) {
+                return Err(shape_err(format!(
+                    "element {} (row {}, column {}) is {}, not a finite number",
+                    k,
+                    k / cols + 1,
+                    k % cols + 1,
+                    v.data[k]
                 )));
             }
             for j in 0..cols {
@@ -461,6 +485,29 @@ mod tests {
         assert!(e.contains("n.csv: line 3, column 2: 'x'"), "{e}");
         std::fs::write(&p, "a,b\n1,2\n3,nan\n").unwrap();
         assert!(Table::read_csv(&p).is_err());
+        // Regression: a MAT variable with NaN gave 'test RMSE NaN' in sysid (CSV/DAT refused it).
+        let mat = dir.path().join("nan.mat");
+        let mut bytes = Vec::new();
+        for v in [0i32, 3, 1, 0, 2] {
+            bytes.extend_from_slice(&v.to_le_bytes()); // level 4: double, 3 × 1, name "u"
+        }
+        bytes.extend_from_slice(b"u\0");
+        for v in [1.0f64, f64::NAN, 3.0] {
+            bytes.extend_from_slice(&v.to_le_bytes());
+        }
+        std::fs::write(&mat, bytes).unwrap();
+        let e = Table::read_mat(&mat, &["u"]).unwrap_err().to_string();
+        assert!(
+            e.contains("nan.mat: variable 'u'") && e.contains("(row 2, column 1) is NaN"),
+            "{e}"
+        );
+        // Regression: a header-less CSV lost its first row (taken as names).
+        std::fs::write(&p, "1,2\n3,4\n").unwrap();
+        let e = Table::read_csv(&p).unwrap_err().to_string();
+        assert!(e.contains("line 1: the first line holds numbers"), "{e}");
+        // A byte-order mark is not part of the first name.
+        std::fs::write(&p, "\u{feff}a,b\n1,2\n").unwrap();
+        assert_eq!(Table::read_csv(&p).unwrap().names, ["a", "b"]);
         // Regression: a repeated header name used to select the first of its columns twice.
         std::fs::write(&p, "# c\nx,y, x\n1,2,3\n").unwrap();
         let e = Table::read_csv(&p).unwrap_err().to_string();
