@@ -88,6 +88,9 @@ pub enum JobError {
         /// Cause.
         source: std::io::Error,
     },
+    /// A table (CSV, ASCII, MAT) could not be read; names the file, line and column.
+    #[error(transparent)]
+    Table(#[from] flapssm_data::table::TableError),
     /// An output path that cannot or must not be written (refused before any work).
     #[error("output {0}")]
     Output(std::io::Error),

@@ -164,6 +164,65 @@ pub struct InputsPrediction {
     pub notes: Vec<String>,
 }
 
+/// Which column of a table feeds each of a model's `n_input` inputs, from the table's header
+/// `names`: for a 7-input model whose header names the wing inputs
+/// ([`flapssm_wing::dataset::INPUT_NAMES`]) in any order, by name; for a header that names none
+/// of them (a model of other inputs), by position.
+///
+/// # Errors
+/// [`JobError::Mismatch`] for another column count, or a header naming some wing inputs but
+/// not all (a renamed or missing column would otherwise be used in another one's place).
+pub fn input_columns(names: &[String], n_input: usize) -> Result<Vec<usize>> {
+    use flapssm_wing::dataset::INPUT_NAMES;
+    if names.len() != n_input {
+        return Err(JobError::Mismatch {
+            what: "input columns".into(),
+            expected: format!("the model's D_u = {n_input} inputs"),
+            found: format!("{} columns", names.len()),
+        });
+    }
+    let position = |wanted: &str| names.iter().position(|n| n.trim() == wanted);
+    let named: Vec<Option<usize>> = INPUT_NAMES.iter().map(|w| position(w)).collect();
+    if named.iter().all(Option::is_none) {
+        return Ok((0..n_input).collect());
+    }
+    if n_input == INPUT_NAMES.len() && named.iter().all(Option::is_some) {
+        return Ok(named.into_iter().flatten().collect());
+    }
+    let missing: Vec<&str> = INPUT_NAMES
+        .iter()
+        .zip(&named)
+        .filter(|(_, p)| p.is_none())
+        .map(|(n, _)| *n)
+        .collect();
+    Err(JobError::Mismatch {
+        what: "input columns".into(),
+        expected: format!("all of the wing inputs {}", INPUT_NAMES.join(",")),
+        found: format!("{} (missing {})", names.join(","), missing.join(",")),
+    })
+}
+
+/// `flapssm predict MODEL --inputs U.csv`: [`predict_inputs`] on a CSV table with a header line,
+/// its columns matched to the model's inputs by [`input_columns`].
+///
+/// # Errors
+/// The table's errors naming the file, line and column; [`input_columns`]' errors; prediction
+/// errors.
+pub fn predict_input_file(
+    model: &PrssmModel,
+    path: &Path,
+    particles: usize,
+    seed: u64,
+) -> Result<InputsPrediction> {
+    let table = flapssm_data::table::Table::read_csv(path)?;
+    let cols = input_columns(&table.names, model.config.n_input)?;
+    let rows: Vec<f64> = (0..table.n_rows())
+        .flat_map(|t| cols.iter().map(move |&c| (c, t)))
+        .map(|(c, t)| table.columns[c][t])
+        .collect();
+    predict_inputs(model, &rows, cols.len(), particles, seed)
+}
+
 /// `flapssm predict MODEL --inputs U.csv`: open-loop prediction from `inputs` (row-major
 /// `T × n_columns`, physical units when the model has normalization statistics, else
 /// standardized) with draws seeded by [`prediction_seed`]`(seed, 0)`, from `x₀ = 0`.
@@ -233,6 +292,28 @@ mod tests {
         });
         let c = predict_prssm(&raw, &ds, 3, 5, &NoProgress).unwrap();
         assert_ne!(a[0].output_mean, c[0].output_mean);
+    }
+
+    /// Regression: reordered or renamed columns were used by position.
+    #[test]
+    fn input_columns_are_matched_by_name() {
+        let names = |s: &str| s.split(',').map(String::from).collect::<Vec<_>>();
+        let wing = "aoa,speed,a_x,a_y,a_z,pitch_rate,pitch_acc";
+        assert_eq!(
+            input_columns(&names(wing), 7).unwrap(),
+            [0, 1, 2, 3, 4, 5, 6]
+        );
+        let reversed = "pitch_acc,pitch_rate,a_z,a_y,a_x,speed,aoa";
+        assert_eq!(
+            input_columns(&names(reversed), 7).unwrap(),
+            [6, 5, 4, 3, 2, 1, 0]
+        );
+        let renamed = "AoA,speed,a_x,a_y,a_z,pitch_rate,pitch_acc";
+        let e = input_columns(&names(renamed), 7).unwrap_err().to_string();
+        assert!(e.contains("missing aoa"), "{e}");
+        assert_eq!(input_columns(&names("u,v"), 2).unwrap(), [0, 1]);
+        let e = input_columns(&names("u,v,w"), 2).unwrap_err().to_string();
+        assert!(e.contains("3 columns"), "{e}");
     }
 
     #[test]

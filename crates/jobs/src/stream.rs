@@ -20,6 +20,7 @@ use flapssm_prssm::train::InitialStateSpec;
 use flapssm_prssm::train::fit::training_record;
 
 use crate::error::{JobError, Result};
+use crate::predict::input_columns;
 use crate::seed::prediction_seed;
 
 /// Settings of a stream.
@@ -129,7 +130,8 @@ pub fn inputs_only_notes(model: &PrssmModel) -> Vec<String> {
     )]
 }
 
-/// Streams a CSV: a header line of `D_u` column names, then one row of `D_u` numbers per time
+/// Streams a CSV: a header line of `D_u` column names (matched to the model's inputs by
+/// [`input_columns`]: by name for the wing's inputs), then one row of `D_u` numbers per time
 /// step. Each row's prediction is written to `output` (`step,mean_0..,var_0..`, after a header
 /// line) and flushed before the next row is read. `source` names the input in errors. Returns
 /// the number of rows streamed.
@@ -155,6 +157,7 @@ pub fn stream_csv(
     };
     let du = stream.n_input;
     let mut u = vec![0.0; du];
+    let mut columns: Vec<usize> = (0..du).collect();
     let mut t = 0u64;
     let mut header = false;
     for (k, line) in input.lines().enumerate() {
@@ -172,11 +175,20 @@ pub fn stream_csv(
             ));
         }
         if !header {
+            if fields.iter().all(|f| f.trim().parse::<f64>().is_ok()) {
+                return Err(parse(
+                    n,
+                    "the first line holds numbers, not column names: a header line comes first"
+                        .into(),
+                ));
+            }
+            columns = input_columns(&fields, du).map_err(|e| parse(n, e.to_string()))?;
             header = true;
             write_csv_header(&mut output, stream.n_output).map_err(io)?;
             continue;
         }
-        for (j, (slot, f)) in u.iter_mut().zip(&fields).enumerate() {
+        for (slot, &j) in u.iter_mut().zip(&columns) {
+            let f = &fields[j];
             *slot = f
                 .trim()
                 .parse::<f64>()
@@ -230,10 +242,22 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("p.csv");
         batch.prediction.write_csv(&path, 5).unwrap();
-        assert_eq!(
-            String::from_utf8(out).unwrap(),
-            std::fs::read_to_string(&path).unwrap()
-        );
+        let batch = std::fs::read_to_string(&path).unwrap();
+        assert_eq!(String::from_utf8(out).unwrap(), batch);
+
+        // The same table with its columns in reverse order: matched by name, same output.
+        let reversed: String = csv
+            .lines()
+            .map(|l| {
+                let mut f: Vec<&str> = l.split(',').collect();
+                f.reverse();
+                f.join(",") + "\n"
+            })
+            .collect();
+        let mut stream = LoadStream::new(&model, &settings).unwrap();
+        let mut out = Vec::new();
+        stream_csv(&mut stream, reversed.as_bytes(), &mut out, "u.csv").unwrap();
+        assert_eq!(String::from_utf8(out).unwrap(), batch);
     }
 
     #[test]
@@ -251,6 +275,7 @@ mod tests {
             ),
             ("a,b\n1,inf\n", "column 2: 'inf' is not a finite number"),
             ("a\n", "line 1: 1 columns"),
+            ("1,2\n3,4\n", "line 1: the first line holds numbers"),
             ("", "no header line"),
         ];
         for (text, message) in cases {

@@ -5,8 +5,7 @@ use std::path::PathBuf;
 
 use anyhow::{Context, bail};
 use clap::Args;
-use flapssm_data::table::Table;
-use flapssm_jobs::predict::{predict_dataset_file, predict_inputs};
+use flapssm_jobs::predict::{predict_dataset_file, predict_input_file};
 use flapssm_prssm::PrssmModel;
 use flapssm_wing::dataset::Dataset;
 
@@ -51,26 +50,15 @@ pub fn run(args: PredictArgs) -> anyhow::Result<()> {
     let model = PrssmModel::load(&args.model)
         .with_context(|| format!("loading model {}", args.model.display()))?;
     if let Some(inputs_path) = &args.inputs {
-        let table = Table::read_csv(inputs_path)
-            .with_context(|| format!("reading inputs {}", inputs_path.display()))?;
-        let t_n = table.n_rows();
-        let rows: Vec<f64> = (0..t_n)
-            .flat_map(|t| table.columns.iter().map(move |c| c[t]))
-            .collect();
-        let p = predict_inputs(
-            &model,
-            &rows,
-            table.columns.len(),
-            args.particles,
-            args.seed,
-        )
-        .with_context(|| {
-            format!(
-                "predicting {} with {}",
-                inputs_path.display(),
-                args.model.display()
-            )
-        })?;
+        let p = predict_input_file(&model, inputs_path, args.particles, args.seed).with_context(
+            || {
+                format!(
+                    "predicting {} with {}",
+                    inputs_path.display(),
+                    args.model.display()
+                )
+            },
+        )?;
         for note in &p.notes {
             eprintln!("warning: {}: {note}", args.model.display());
         }
@@ -78,7 +66,8 @@ pub fn run(args: PredictArgs) -> anyhow::Result<()> {
             .write_csv(&args.out, model.config.n_output)
             .with_context(|| format!("writing {}", args.out.display()))?;
         println!(
-            "{t_n} steps, {} particles -> {}",
+            "{} steps, {} particles -> {}",
+            p.prediction.output_mean.len() / model.config.n_output.max(1),
             args.particles,
             args.out.display()
         );
