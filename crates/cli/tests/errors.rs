@@ -33,6 +33,13 @@ fn fixtures(dir: &Path) {
     );
     let data = simulated(dir, 3, 1);
     std::fs::rename(data, dir.join("data.npz")).unwrap();
+    ok(&[
+        "qs",
+        "fit",
+        s(&dir.join("data.npz")),
+        "--out",
+        s(&dir.join("lrqsm.json")),
+    ]);
     // The exported CSV with one value (line 10, column 12: a_z) replaced by NaN.
     let csv = dir.join("data.csv");
     ok(&[
@@ -158,6 +165,15 @@ fn bad_inputs_are_refused_naming_the_file_and_writing_nothing() {
                 "OUT",
             ],
             vec!["foreign.json", "something-else"],
+        ),
+        // Regression: an LRQSM file given as a PR-SSM model said "missing field `format` at
+        // line 15361".
+        (
+            vec!["predict", &p("lrqsm.json"), &p("data.npz"), "--out", "OUT"],
+            vec![
+                "lrqsm.json",
+                "format 'flapssm-lrqsm', expected 'flapssm-prssm-model'",
+            ],
         ),
         (
             vec![

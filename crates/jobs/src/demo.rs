@@ -147,10 +147,18 @@ impl DemoConfig {
     /// naming the field).
     pub fn check(&self) -> Result<DemoPlan> {
         self.simulation.wing.check()?;
-        self.simulation
-            .trajectories
-            .check()
+        let t = &self.simulation.trajectories;
+        t.check()
             .map_err(flapssm_wing::virtual_wing::SimulateError::from)?;
+        if t.n_train == 0 || t.n_train >= t.n_trajectories {
+            return Err(JobError::Setting {
+                name: "trajectories".into(),
+                value: format!("{} ({} for training)", t.n_trajectories, t.n_train),
+                expected: "at least one training and one test trajectory: the demo reports \
+                           test errors"
+                    .into(),
+            });
+        }
         self.lrqsm.validate()?;
         self.evaluation.check()?;
         Ok(DemoPlan {
@@ -590,8 +598,16 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let out = dir.path().join("demo");
         type Edit = fn(&mut DemoConfig);
-        let cases: [(&str, Edit); 6] = [
+        let cases: [(&str, Edit); 7] = [
             ("n_train", |c| c.simulation.trajectories.n_train = 500),
+            // Regression: `demo --trajectories 1` reported the training RMSE as "test RMSE".
+            (
+                "trajectories = 1 (1 for training): at least one training and one test",
+                |c| {
+                    c.simulation.trajectories.n_trajectories = 1;
+                    c.simulation.trajectories.n_train = 1;
+                },
+            ),
             ("fluid.kinematic_viscosity_m2_s", |c| {
                 c.simulation.wing.fluid.kinematic_viscosity_m2_s = 0.0
             }),

@@ -71,10 +71,20 @@ struct FileOut<'a> {
     model: &'a PrssmModel,
 }
 
+fn not_a_model(path: &Path, message: &str) -> ModelFileError {
+    ModelFileError::Parse {
+        path: path.to_path_buf(),
+        message: message.into(),
+    }
+}
+
+/// The tags a file is recognized by before its body is parsed (another flapssm file, e.g. an
+/// LRQSM model, carries `kind` instead of `format`).
 #[derive(Deserialize)]
 struct Header {
-    format: String,
-    version: u64,
+    format: Option<String>,
+    kind: Option<String>,
+    version: Option<u64>,
 }
 
 #[derive(Deserialize)]
@@ -141,16 +151,22 @@ impl PrssmModel {
             message: e.to_string(),
         };
         let header: Header = serde_json::from_str(text).map_err(parse)?;
-        if header.format != MODEL_FORMAT {
+        if header.format.as_deref() != Some(MODEL_FORMAT) {
             return Err(ModelFileError::Format {
                 path: path.to_path_buf(),
-                found: header.format,
+                found: header
+                    .format
+                    .or(header.kind)
+                    .unwrap_or_else(|| "none".into()),
             });
         }
-        if header.version > MODEL_VERSION as u64 {
+        let version = header
+            .version
+            .ok_or_else(|| not_a_model(path, "the field 'version' is missing"))?;
+        if version > MODEL_VERSION as u64 {
             return Err(ModelFileError::Version {
                 path: path.to_path_buf(),
-                found: header.version,
+                found: version,
             });
         }
         let file: FileIn = serde_json::from_str(text).map_err(parse)?;
