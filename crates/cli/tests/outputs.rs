@@ -263,3 +263,64 @@ fn sigterm_stops_training_with_a_checkpoint() {
     assert!(text.contains("resum"), "{text}");
     assert_eq!(o.status.code(), Some(1), "{text}");
 }
+
+/// Sizes whose memory the machine does not have are refused before any work, with the
+/// estimate (they used to abort on a failed allocation, exit 134).
+#[cfg(target_os = "linux")]
+#[test]
+fn sizes_beyond_the_machine_are_refused_up_front() {
+    let tmp = tempfile::tempdir().unwrap();
+    let d = tmp.path();
+    let data = simulated(d, 3, 1);
+    let ds = s(&data);
+    let model = d.join("m.json");
+    ok(&[
+        "train",
+        ds,
+        "--out",
+        s(&model),
+        "--dx",
+        "5",
+        "--inducing",
+        "4",
+        "--particles",
+        "2",
+        "--epochs",
+        "1",
+    ]);
+    let m = s(&model);
+    let out = d.join("out.npz");
+    let o = s(&out);
+    let demo = d.join("demo");
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        (
+            vec!["simulate", "--n", "100000000000", "--out", o],
+            "n = 100000000000",
+        ),
+        (
+            vec!["predict", m, ds, "--particles", "1000000000", "--out", o],
+            "particles = 1000000000",
+        ),
+        (
+            vec![
+                "train",
+                ds,
+                "--out",
+                o,
+                "--particles",
+                "100000000",
+                "--epochs",
+                "1",
+            ],
+            "particles = 100000000",
+        ),
+        (
+            vec!["demo", "--trajectories", "10000000000", "--out", s(&demo)],
+            "trajectories = 10000000000",
+        ),
+    ];
+    for (args, setting) in &cases {
+        refused(args, &[setting, "of memory, more than the", "available"], d);
+    }
+    assert!(!demo.exists());
+}

@@ -150,6 +150,11 @@ impl DemoConfig {
         let t = &self.simulation.trajectories;
         t.check()
             .map_err(flapssm_wing::virtual_wing::SimulateError::from)?;
+        crate::resources::check_memory(
+            "trajectories",
+            t.n_trajectories,
+            crate::resources::dataset_bytes(t.n_trajectories, t.sampling.n_samples),
+        )?;
         if t.n_train == 0 || t.n_train >= t.n_trajectories {
             return Err(JobError::Setting {
                 name: "trajectories".into(),

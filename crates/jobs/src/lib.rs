@@ -17,7 +17,8 @@
 //! | [`sysid`] | Doerr et al. system-identification protocol (fit, open-loop test, RMSE/NLL) |
 //!
 //! Shared pieces: [`error`] (one error type naming the file, trajectory or stage), [`progress`]
-//! (the progress sink a caller supplies), [`seed`] (the one seed-derivation rule), [`files`]
+//! (the progress sink a caller supplies), [`resources`] (memory estimates checked before any
+//! work), [`seed`] (the one seed-derivation rule), [`files`]
 //! (atomic JSON and text files), [`threads`] (the pool a job runs on).
 #![warn(missing_docs)]
 
@@ -29,6 +30,7 @@ pub mod files;
 pub mod models;
 pub mod predict;
 pub mod progress;
+pub mod resources;
 pub mod seed;
 pub mod simulate;
 pub mod stream;

@@ -72,6 +72,11 @@ impl SimulateSettings {
         if self.flat {
             trajectories.max_deviation_deg = 0.0;
         }
+        crate::resources::check_memory(
+            "n",
+            n,
+            crate::resources::dataset_bytes(n, trajectories.sampling.n_samples),
+        )?;
         Ok(SimulationConfig {
             wing: VirtualWingConfig {
                 fidelity: self.fidelity,

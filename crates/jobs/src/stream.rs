@@ -66,6 +66,11 @@ impl LoadStream {
             });
         }
         let dx = model.config.n_state;
+        crate::resources::check_memory(
+            "particles",
+            settings.particles,
+            crate::resources::particle_bytes(settings.particles, 2, dx, model.config.n_inducing),
+        )?;
         let zero = vec![0.0; dx];
         let predictor = StreamPredictor::new(
             model,

@@ -248,6 +248,18 @@ pub fn train_prssm(
     stop: Option<&AtomicBool>,
 ) -> Result<FitOutcome> {
     let (fit_set, val_set) = plan.split(train)?;
+    let s = &plan.spec;
+    let longest = train.iter().map(|t| t.inputs.len()).max().unwrap_or(0);
+    crate::resources::check_memory(
+        "particles",
+        s.particles,
+        crate::resources::particle_bytes(
+            s.particles * s.train.batch_size,
+            longest,
+            s.model.n_state,
+            s.model.n_inducing,
+        ),
+    )?;
     let fit_seqs: Vec<SequenceView<'_>> = fit_set.iter().map(trajectory_sequence).collect();
     let val_seqs: Vec<SequenceView<'_>> = val_set.iter().map(trajectory_sequence).collect();
     let mut on_event = |e: &TrainEvent<'_>| match e {

@@ -13,6 +13,7 @@ use super::{Fit, LoadModel, LoadPrediction, check_buffer};
 use crate::error::{JobError, Result};
 use crate::predict::{in_dataset_units, trajectory_sequence};
 use crate::progress::Progress;
+use crate::resources;
 use crate::seed::prediction_seed;
 use crate::train::{TrainingPlan, train_prssm};
 
@@ -53,6 +54,14 @@ impl<'m> PrssmLoadModel<'m> {
                 expected: "must be at least 1".into(),
             });
         }
+        // Each thread simulates one trajectory's particles; every trajectory's moments are kept.
+        let threads = crate::threads::current_threads();
+        let moments = 4.0 * (ds.len() * ds.n_samples() * c.n_state) as f64 * 8.0;
+        crate::resources::check_memory(
+            "particles",
+            particles,
+            resources::particle_bytes(particles * threads, 2, c.n_state, c.n_inducing) + moments,
+        )?;
         let history = training_record(model)
             .ok()
             .map(|r| r.history)
