@@ -234,11 +234,7 @@ fn sigterm_stops_training_with_a_checkpoint() {
     assert!(err.contains("--resume"), "{err}");
     let ckpt = d.join("m.ckpt.json");
     assert!(ckpt.exists());
-    let leftovers: Vec<_> = std::fs::read_dir(d)
-        .unwrap()
-        .filter_map(|e| e.ok())
-        .filter(|e| e.file_name().to_string_lossy().ends_with(".tmp"))
-        .collect();
+    let leftovers = common::temporaries(d);
     assert!(leftovers.is_empty(), "{leftovers:?}");
 
     // Resuming reads the checkpoint (it would refuse one of another run).

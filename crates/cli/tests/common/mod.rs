@@ -53,13 +53,19 @@ pub fn assert_fails(o: &Output, needles: &[&str], out: &Path) {
     assert!(!err.contains("panicked"), "{err}");
     assert!(!out.exists(), "{} was written", out.display());
     if let Some(dir) = out.parent().filter(|d| d.is_dir()) {
-        let leftovers: Vec<_> = std::fs::read_dir(dir)
-            .unwrap()
-            .filter_map(|e| e.ok())
-            .filter(|e| e.file_name().to_string_lossy().ends_with(".tmp"))
-            .collect();
+        let leftovers = temporaries(dir);
         assert!(leftovers.is_empty(), "temporary files left: {leftovers:?}");
     }
+}
+
+/// The temporary files (`*.tmp`) in `dir`.
+pub fn temporaries(dir: &Path) -> Vec<PathBuf> {
+    std::fs::read_dir(dir)
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .map(|e| e.path())
+        .filter(|p| p.to_string_lossy().ends_with(".tmp"))
+        .collect()
 }
 
 /// A small simulated dataset with outputs (quasi-steady aerodynamics, sensor model):

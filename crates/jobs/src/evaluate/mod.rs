@@ -6,7 +6,7 @@
 //!   latent states (the PR-SSM: standardized latent units, `n × D_x`, particle draws seeded by
 //!   [`crate::seed::prediction_seed`]`(seed, i)`).
 //! - Standardized errors `e = (y − ŷ)/σ_y` with the dataset's training statistics
-//!   ([`ValidDataset::standardization`]), pooled from `start_sample` on (published: the first 93
+//!   ([`flapssm_wing::dataset::Dataset::standardization`]), pooled from `start_sample` on (published: the first 93
 //!   samples dropped): per-output RMSE, overall `√mean(e²)`, 2.5/97.5 % intervals.
 //! - Coefficients `C_F = F/(½ρSU_ref²)`, `C_M = M/(½ρc̄SU_ref²·1000)` per trajectory; the last
 //!   full cycle from [`flapssm_wing::cycles::published_window`]; per-trajectory C_Fx/C_Fy RMSE

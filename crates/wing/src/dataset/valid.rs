@@ -2,7 +2,7 @@
 //! [`Dataset::validate`], read-only from then on.
 //!
 //! Every reader and simulator returns one ([`Dataset::load`], [`Dataset::import_csv`],
-//! [`super::published::import`], [`crate::virtual_wing::simulate_dataset`]), and every job takes
+//! [`super::published::import_published_mat`], [`crate::virtual_wing::simulate_dataset`]), and every job takes
 //! one, so a dataset is validated where it enters the program and never again. It dereferences
 //! to [`Dataset`] for reading; to edit, take the [`Dataset`] out ([`ValidDataset::into_inner`])
 //! and check it again ([`ValidDataset::new`]).
