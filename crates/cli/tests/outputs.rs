@@ -320,3 +320,119 @@ fn sizes_beyond_the_machine_are_refused_up_front() {
     }
     assert!(!demo.exists());
 }
+
+/// `kill -9` at 24 seeded random moments of `simulate` and of `train` (checkpoint every epoch,
+/// resumed after each kill) never leaves a corrupt dataset, model or checkpoint at the target
+/// paths; `--resume` always continues; the temporaries of killed writes are gone after the next
+/// successful write of the same names.
+#[cfg(target_os = "linux")]
+#[test]
+fn kill_9_never_leaves_a_corrupt_file() {
+    use std::process::{Command, Stdio};
+    use std::time::Duration;
+    let tmp = tempfile::tempdir().unwrap();
+    let d = tmp.path();
+    // A seeded generator of kill times (64-bit LCG; the test needs no more).
+    let mut state = 0x2545_f491_4f6c_dd1du64;
+    let mut uniform = move || {
+        state = state
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let run_killed = |args: &[&str], after: Duration| {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_flapssm"))
+            .args(args)
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .unwrap();
+        std::thread::sleep(after);
+        let _ = child.kill(); // SIGKILL
+        child.wait().unwrap()
+    };
+
+    let data = d.join("ds.npz");
+    let simulate = [
+        "simulate",
+        "--n",
+        "300",
+        "--fidelity",
+        "l0",
+        "--quiet",
+        "--out",
+        s(&data),
+    ];
+    for k in 0..12 {
+        run_killed(&simulate, Duration::from_secs_f64(1.5 * uniform()));
+        if data.exists() {
+            let ds = flapssm_wing::dataset::Dataset::load(&data)
+                .unwrap_or_else(|e| panic!("kill {k}: corrupt dataset: {e}"));
+            assert_eq!(ds.len(), 300);
+        }
+    }
+    ok(&simulate);
+    assert!(
+        common::temporaries(d).is_empty(),
+        "{:?}",
+        common::temporaries(d)
+    );
+
+    let model = d.join("m.json");
+    let ckpt = d.join("m.ckpt.json");
+    let train = |resume: bool| {
+        let mut a = vec![
+            "train",
+            s(&data),
+            "--out",
+            s(&model),
+            "--dx",
+            "5",
+            "--inducing",
+            "8",
+            "--particles",
+            "2",
+            "--batch",
+            "8",
+            "--epochs",
+            "160",
+            "--checkpoint-every",
+            "1",
+            "--seed",
+            "3",
+        ];
+        if resume {
+            a.push("--resume");
+        }
+        a.into_iter().map(String::from).collect::<Vec<_>>()
+    };
+    for k in 0..12 {
+        let args = train(ckpt.exists());
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let status = run_killed(&args, Duration::from_secs_f64(0.2 + 1.5 * uniform()));
+        assert!(
+            status.success() || status.code().is_none(),
+            "kill {k}: a resumed run failed by itself: {status}"
+        );
+        if ckpt.exists() {
+            let c = flapssm_prssm::train::Checkpoint::load(&ckpt)
+                .unwrap_or_else(|e| panic!("kill {k}: corrupt checkpoint: {e}"));
+            eprintln!("kill {k}: {status}; checkpoint at step {}", c.state.step);
+        }
+        for m in [&model, &d.join("m.last.json")] {
+            if m.exists() {
+                flapssm_prssm::PrssmModel::load(m)
+                    .unwrap_or_else(|e| panic!("kill {k}: corrupt model: {e}"));
+            }
+        }
+    }
+    let args = train(ckpt.exists());
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    ok(&args);
+    flapssm_prssm::PrssmModel::load(&model).unwrap();
+    assert!(
+        common::temporaries(d).is_empty(),
+        "{:?}",
+        common::temporaries(d)
+    );
+}
