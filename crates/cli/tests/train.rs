@@ -184,3 +184,43 @@ fn a_divergent_learning_rate_is_reported_and_the_step_undone() {
     assert!(err.contains("learning-rate factor now 5.000e-1"), "{err}");
     assert!(out.exists());
 }
+
+/// A finished run resumed with a larger budget is extended from where it stopped: 3 epochs,
+/// then `--resume --epochs 6`, ends byte-identical to 6 epochs in one go (constant learning
+/// rate), and says so; a smaller budget than the checkpoint's step is refused.
+#[test]
+fn a_finished_run_is_extended_by_resuming_with_a_larger_budget() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let data = simulated(d, 4, 5);
+    let (ext, once) = (d.join("ext.json"), d.join("once.json"));
+    ok(&train_args(&data, &ext, "3"));
+    let mut args = train_args(&data, &ext, "6");
+    args.push("--resume");
+    let o = flapssm(&args);
+    let text =
+        String::from_utf8_lossy(&o.stdout).into_owned() + &String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{text}");
+    assert!(
+        text.contains("extending the run from 3 epochs to 6 epochs")
+            && text.contains("the constant learning rate continues"),
+        "{text}"
+    );
+    ok(&train_args(&data, &once, "6"));
+    for (a, b) in [
+        ("ext.json", "once.json"),
+        ("ext.last.json", "once.last.json"),
+    ] {
+        assert_eq!(
+            std::fs::read(d.join(a)).unwrap(),
+            std::fs::read(d.join(b)).unwrap(),
+            "{a}"
+        );
+    }
+    let mut args = train_args(&data, &ext, "2");
+    args.push("--resume");
+    let o = flapssm(&args);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(err.contains("past this run's"), "{err}");
+}

@@ -324,6 +324,37 @@ pub fn train_prssm(
     Ok(out)
 }
 
+/// What resuming a checkpoint under a larger budget does (`None` for the same budget): the
+/// run continues from `step`, and a schedule that depends on the budget is recomputed over the
+/// new one, so the learning rate from `step` on follows the new curve.
+fn extension_note(
+    old: &flapssm_prssm::train::TrainConfig,
+    new: &flapssm_prssm::train::TrainConfig,
+    step: u64,
+) -> Option<String> {
+    use flapssm_prssm::train::LrSchedule;
+    if old.budget == new.budget {
+        return None;
+    }
+    let budget = |b: &Budget| match b {
+        Budget::Epochs(n) => format!("{n} epochs"),
+        Budget::Iterations(n) => format!("{n} iterations"),
+    };
+    let schedule = match new.schedule {
+        LrSchedule::Constant => "the constant learning rate continues".to_string(),
+        _ => format!(
+            "the {:?} schedule is recomputed over the new budget, so the learning rate from here \
+             on follows its new curve",
+            new.schedule
+        ),
+    };
+    Some(format!(
+        "extending the run from {} to {} at step {step}: {schedule}",
+        budget(&old.budget),
+        budget(&new.budget)
+    ))
+}
+
 /// The files of a training run: the best model, the last model and the checkpoint.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TrainFiles {
@@ -395,6 +426,11 @@ pub fn train_dataset(
         None
     };
     progress.start("train PR-SSM", 0);
+    if let Some(ck) = &resume
+        && let Some(note) = extension_note(&ck.config, &plan.spec.train, ck.state.step)
+    {
+        progress.println(&note);
+    }
     let out = train_prssm(
         ds.train(),
         plan,

@@ -417,8 +417,22 @@ pub fn train<O: Objective + ?Sized>(
     let total_steps = config.total_steps(plan.batches_per_epoch());
     let mut state = match resume {
         Some(ck) => {
-            if let Some((field, why)) = config_difference(&ck.config, config) {
+            // Only the budget may grow: the run is then extended from where it stopped.
+            let same_budget = TrainConfig {
+                budget: config.budget,
+                ..ck.config.clone()
+            };
+            if let Some((field, why)) = config_difference(&same_budget, config) {
                 return Err(TrainError::ResumeMismatch { field, why });
+            }
+            if ck.state.step > total_steps {
+                return Err(TrainError::ResumeMismatch {
+                    field: "budget".into(),
+                    why: format!(
+                        "the checkpoint is at step {}, past this run's {total_steps} steps",
+                        ck.state.step
+                    ),
+                });
             }
             if ck.state.params.len() != n {
                 return Err(TrainError::ResumeMismatch {
@@ -631,6 +645,8 @@ pub fn train<O: Objective + ?Sized>(
             }
         }
     }
+    // The final state, so that a finished run can be extended (resumed with a larger budget).
+    save(&state)?;
     Ok(TrainOutcome {
         state,
         total_steps,
