@@ -39,7 +39,8 @@ pub enum MatError {
         /// What is wrong.
         message: String,
     },
-    /// A variable of an unsupported kind (only with [`MatOptions::strict`]).
+    /// A variable of an unsupported kind: on reading with [`MatOptions::strict`], or when a
+    /// skipped variable is asked for by name.
     #[error("{path}: variable '{variable}': {message}")]
     Unsupported {
         /// File involved.
@@ -210,8 +211,16 @@ impl MatFile {
     /// The numeric variable `name`.
     ///
     /// # Errors
-    /// [`MatError::Missing`] listing the variables present.
+    /// [`MatError::Unsupported`] for a variable of a kind that was skipped (char, cell, complex,
+    /// …), saying which; [`MatError::Missing`] listing the variables present.
     pub fn get(&self, name: &str) -> Result<&MatVariable, MatError> {
+        if let Some((_, reason)) = self.skipped.iter().find(|(n, _)| n == name) {
+            return Err(MatError::Unsupported {
+                path: self.path.clone(),
+                variable: name.to_string(),
+                message: format!("{reason}; only numeric arrays can be read"),
+            });
+        }
         self.variables
             .iter()
             .find(|v| v.name == name)
@@ -442,6 +451,12 @@ mod tests {
             assert_eq!(b.data, vec![1.0, 0.0, 0.0, 1.0]);
             let skipped: Vec<&str> = m.skipped.iter().map(|(n, _)| n.as_str()).collect();
             assert_eq!(skipped, vec!["txt", "cel", "st"], "{f}");
+            // Regression: a char variable asked for by name was reported "missing".
+            let e = m.get("txt").unwrap_err().to_string();
+            assert!(
+                e.contains("'txt'") && e.contains("char") && !e.contains("missing"),
+                "{e}"
+            );
             let e = MatFile::read_with(fixture(f), MatOptions { strict: true }).unwrap_err();
             assert!(
                 e.to_string().contains("'txt'") && e.to_string().contains("char"),
