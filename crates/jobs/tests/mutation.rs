@@ -1,6 +1,6 @@
-//! Seeded mutation suite of every file reader: small valid files (dataset `.npz` and CSV, PR-SSM
-//! model, training checkpoint, LRQSM model, MAT level 4 and 5, a CSV table, the sweep-result and
-//! demo-stage JSON) are corrupted thousands of times — bits flipped, truncated, bytes
+//! Seeded mutation suite of every file reader: small valid files (dataset `.npz` written by
+//! flapssm and by numpy, dataset CSV, PR-SSM model, training checkpoint, LRQSM model, MAT level 4
+//! and 5, the published dataset's `.mat` layout, CSV and whitespace tables) are corrupted thousands of times — bits flipped, truncated, bytes
 //! overwritten, inserted or deleted — and each reader must answer every case with `Ok` or an
 //! error naming the file, never a panic. Prints the count of cases, errors and accepted
 //! mutations (a flipped digit can leave a valid file) and the time.
@@ -19,6 +19,7 @@ use flapssm_prssm::PrssmModel;
 use flapssm_prssm::train::Checkpoint;
 use flapssm_qs::{EnetOptions, LrqsmModel};
 use flapssm_wing::dataset::Dataset;
+use flapssm_wing::dataset::published::import_published_mat;
 use flapssm_wing::features::FeatureSet;
 use flapssm_wing::virtual_wing::{Fidelity, SimulationConfig, simulate_dataset};
 use rand::{Rng, SeedableRng};
@@ -76,6 +77,8 @@ fn fixtures(dir: &Path) -> Vec<(&'static str, PathBuf, Reader)> {
 
     let table = dir.join("t.csv");
     std::fs::write(&table, "u,y\n0.1,0.2\n0.3,-0.4\n1e-3,5\n").unwrap();
+    let ascii = dir.join("t.dat");
+    std::fs::write(&ascii, "% u y\n0.1 0.2\n0.3 -0.4\n1e-3 5\n").unwrap();
     let fixture = |name: &str| {
         Path::new(env!("CARGO_MANIFEST_DIR"))
             .join("../data/tests/fixtures")
@@ -101,6 +104,28 @@ fn fixtures(dir: &Path) -> Vec<(&'static str, PathBuf, Reader)> {
         ("table csv", table, |p| {
             Table::read_csv(p).map(drop).map_err(err)
         }),
+        ("table ascii", ascii, |p| {
+            Table::read_ascii(p).map(drop).map_err(err)
+        }),
+        ("published MAT v5", fixture("published_v5.mat"), |p| {
+            import_published_mat(p, Some(3), |_, _| Ok(0.1))
+                .map(drop)
+                .map_err(err)
+        }),
+        (
+            "published MAT v5 compressed",
+            fixture("published_v5z.mat"),
+            |p| {
+                import_published_mat(p, Some(3), |_, _| Ok(0.1))
+                    .map(drop)
+                    .map_err(err)
+            },
+        ),
+        (
+            "numpy-written dataset npz",
+            fixture("tiny_dataset.npz"),
+            |p| Dataset::load(p).map(drop).map_err(err),
+        ),
         ("MAT v4", fixture("small_v4.mat"), |p| {
             MatFile::read(p).map(drop).map_err(err)
         }),
