@@ -16,8 +16,9 @@
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
-/// An output path flapssm refuses, with the reason in words.
-fn refused(path: &Path, why: &str) -> std::io::Error {
+/// An output path flapssm refuses, with the reason in words: an
+/// [`std::io::ErrorKind::InvalidInput`] error `path: why`.
+pub fn refused(path: &Path, why: &str) -> std::io::Error {
     std::io::Error::new(
         std::io::ErrorKind::InvalidInput,
         format!("{}: {why}", path.display()),

@@ -127,6 +127,11 @@ pub struct Table {
     pub columns: Vec<Vec<f64>>,
 }
 
+/// Whether every field of a line is a number: a data row, not a header of column names.
+pub fn is_number_row(fields: &[String]) -> bool {
+    fields.iter().all(|f| f.trim().parse::<f64>().is_ok())
+}
+
 /// The file's text, without a leading UTF-8 byte-order mark (spreadsheet exports write one).
 fn read_text(path: &Path) -> Result<String, TableError> {
     let text = std::fs::read_to_string(path).map_err(|error| TableError::Io {
@@ -199,7 +204,7 @@ impl Table {
             message,
         };
         let names: Vec<String> = split_csv_line(header).map_err(|m| syntax(hk + 1, m))?;
-        if names.iter().all(|n| n.trim().parse::<f64>().is_ok()) {
+        if is_number_row(&names) {
             return Err(syntax(
                 hk + 1,
                 "the first line holds numbers, not column names: a CSV needs a header line \

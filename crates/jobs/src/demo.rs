@@ -150,11 +150,7 @@ impl DemoConfig {
         let t = &self.simulation.trajectories;
         t.check()
             .map_err(flapssm_wing::virtual_wing::SimulateError::from)?;
-        crate::resources::check_memory(
-            "trajectories",
-            t.n_trajectories,
-            crate::resources::dataset_bytes(t.n_trajectories, t.sampling.n_samples),
-        )?;
+        crate::resources::check_dataset("trajectories", t.n_trajectories, t.sampling.n_samples)?;
         if t.n_train == 0 || t.n_train >= t.n_trajectories {
             return Err(JobError::Setting {
                 name: "trajectories".into(),

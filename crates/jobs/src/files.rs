@@ -2,6 +2,7 @@
 
 use std::path::Path;
 
+use flapssm_data::atomic::refused;
 use serde::Serialize;
 
 use crate::error::{JobError, Result};
@@ -58,11 +59,10 @@ pub fn check_outputs(outputs: &[&Path], inputs: &[&Path]) -> Result<()> {
     for (k, out) in outputs.iter().enumerate() {
         flapssm_data::atomic::check_output(out).map_err(JobError::Output)?;
         let clash = |other: &Path, what: &str| {
-            JobError::Output(std::io::Error::new(
-                std::io::ErrorKind::InvalidInput,
-                format!(
-                    "{}: is the {what} {}; writing it would destroy it",
-                    out.display(),
+            JobError::Output(refused(
+                out,
+                &format!(
+                    "is the {what} {}; writing it would destroy it",
                     other.display()
                 ),
             ))
@@ -95,12 +95,7 @@ pub fn check_figure_output(path: &Path, inputs: &[&Path]) -> Result<()> {
 /// # Errors
 /// [`JobError::Output`] for an existing non-directory or a missing parent.
 pub fn check_output_dir(dir: &Path) -> Result<()> {
-    let refuse = |why: String| {
-        Err(JobError::Output(std::io::Error::new(
-            std::io::ErrorKind::InvalidInput,
-            format!("{}: {why}", dir.display()),
-        )))
-    };
+    let refuse = |why: String| Err(JobError::Output(refused(dir, &why)));
     match std::fs::metadata(dir) {
         Ok(m) if m.is_dir() => Ok(()),
         Ok(_) => refuse("exists and is not a directory".into()),

@@ -244,12 +244,7 @@ pub fn predict_inputs(
             found: format!("{n_columns} columns"),
         });
     }
-    let c = &model.config;
-    crate::resources::check_memory(
-        "particles",
-        particles,
-        crate::resources::particle_bytes(particles, 2, c.n_state, c.n_inducing),
-    )?;
+    crate::resources::check_prediction(&model.config, particles, 1, 0.0)?;
     let notes = inputs_only_notes(model);
     let prediction = model
         .predict_inputs(inputs, particles, prediction_seed(seed, 0))

@@ -57,6 +57,30 @@ fn human(bytes: f64) -> String {
     format!("{v:.3} {}", units[k])
 }
 
+/// [`check_memory`] for a dataset of `n` trajectories of `n_samples` ([`dataset_bytes`]),
+/// `name` being the setting that gives `n`.
+///
+/// # Errors
+/// As [`check_memory`].
+pub fn check_dataset(name: &str, n: usize, n_samples: usize) -> Result<()> {
+    check_memory(name, n, dataset_bytes(n, n_samples))
+}
+
+/// [`check_memory`] for a prediction with `particles` particles of a model of `config`, run
+/// `streams` at a time (one per thread), plus `kept` bytes of results.
+///
+/// # Errors
+/// As [`check_memory`], naming `particles`.
+pub fn check_prediction(
+    config: &flapssm_prssm::ModelConfig,
+    particles: usize,
+    streams: usize,
+    kept: f64,
+) -> Result<()> {
+    let bytes = particle_bytes(particles * streams, 2, config.n_state, config.n_inducing);
+    check_memory("particles", particles, bytes + kept)
+}
+
 /// Bytes of a simulated dataset of `n` trajectories of `n_samples`: Euler angles, 7 inputs and
 /// 5 outputs in f64, twice (the dataset and the file's arrays while it is written).
 pub fn dataset_bytes(n: usize, n_samples: usize) -> f64 {

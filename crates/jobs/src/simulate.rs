@@ -72,11 +72,7 @@ impl SimulateSettings {
         if self.flat {
             trajectories.max_deviation_deg = 0.0;
         }
-        crate::resources::check_memory(
-            "n",
-            n,
-            crate::resources::dataset_bytes(n, trajectories.sampling.n_samples),
-        )?;
+        crate::resources::check_dataset("n", n, trajectories.sampling.n_samples)?;
         Ok(SimulationConfig {
             wing: VirtualWingConfig {
                 fidelity: self.fidelity,

@@ -12,7 +12,7 @@
 
 use std::io::{BufRead, Write};
 
-use flapssm_data::table::split_csv_line;
+use flapssm_data::table::{is_number_row, split_csv_line};
 use flapssm_prssm::PrssmModel;
 use flapssm_prssm::predict::{write_csv_header, write_csv_row};
 use flapssm_prssm::stream::StreamPredictor;
@@ -66,11 +66,7 @@ impl LoadStream {
             });
         }
         let dx = model.config.n_state;
-        crate::resources::check_memory(
-            "particles",
-            settings.particles,
-            crate::resources::particle_bytes(settings.particles, 2, dx, model.config.n_inducing),
-        )?;
+        crate::resources::check_prediction(&model.config, settings.particles, 1, 0.0)?;
         let zero = vec![0.0; dx];
         let predictor = StreamPredictor::new(
             model,
@@ -180,7 +176,7 @@ pub fn stream_csv(
             ));
         }
         if !header {
-            if fields.iter().all(|f| f.trim().parse::<f64>().is_ok()) {
+            if is_number_row(&fields) {
                 return Err(parse(
                     n,
                     "the first line holds numbers, not column names: a header line comes first"

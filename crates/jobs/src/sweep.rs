@@ -13,7 +13,7 @@ use std::time::Instant;
 
 use flapssm_prssm::train::EpochRecord;
 use flapssm_prssm::train::fit::FitSpec;
-use flapssm_wing::dataset::{OUTPUT_NAMES, ValidDataset};
+use flapssm_wing::dataset::{OUTPUT_NAMES, Standardization, ValidDataset};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{JobError, Result};
@@ -140,6 +140,8 @@ pub struct SweepPlan {
     options: TrainingOptions,
     training: TrainingPlan,
     used: usize,
+    /// The dataset's training statistics: the one scale of every configuration's errors.
+    stats: Standardization,
 }
 
 impl SweepSettings {
@@ -190,12 +192,12 @@ impl SweepSettings {
                 ),
             ));
         }
-        ds.standardization()?;
         Ok(SweepPlan {
             settings: self.clone(),
             training: options.check()?,
             options,
             used,
+            stats: ds.standardization()?,
         })
     }
 }
@@ -219,9 +221,8 @@ pub fn sweep_run(
         start_sample,
         ..
     } = plan.settings;
-    let (used, opts) = (plan.used, plan.options.clone());
+    let (used, opts, stats) = (plan.used, plan.options.clone(), &plan.stats);
     let plan = &plan.training;
-    let stats = ds.standardization()?;
     let train = &ds.trajectories[..used];
     let (fit_set, val_set) = plan.split(train)?;
     let (n_fit, n_val) = (fit_set.len(), val_set.len());

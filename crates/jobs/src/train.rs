@@ -224,10 +224,7 @@ impl TrainingPlan {
             s.model.n_state,
             s.model.n_inducing,
             s.particles,
-            match s.train.budget {
-                Budget::Epochs(n) => format!("{n} epochs"),
-                Budget::Iterations(n) => format!("{n} iterations"),
-            }
+            budget_text(&s.train.budget)
         ))
     }
 }
@@ -336,10 +333,6 @@ fn extension_note(
     if old.budget == new.budget {
         return None;
     }
-    let budget = |b: &Budget| match b {
-        Budget::Epochs(n) => format!("{n} epochs"),
-        Budget::Iterations(n) => format!("{n} iterations"),
-    };
     let schedule = match new.schedule {
         LrSchedule::Constant => "the constant learning rate continues".to_string(),
         _ => format!(
@@ -350,9 +343,17 @@ fn extension_note(
     };
     Some(format!(
         "extending the run from {} to {} at step {step}: {schedule}",
-        budget(&old.budget),
-        budget(&new.budget)
+        budget_text(&old.budget),
+        budget_text(&new.budget)
     ))
+}
+
+/// A budget in words: `N epochs` or `N iterations`.
+fn budget_text(budget: &Budget) -> String {
+    match budget {
+        Budget::Epochs(n) => format!("{n} epochs"),
+        Budget::Iterations(n) => format!("{n} iterations"),
+    }
 }
 
 /// The files of a training run: the best model, the last model and the checkpoint.

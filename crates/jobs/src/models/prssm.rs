@@ -57,11 +57,7 @@ impl<'m> PrssmLoadModel<'m> {
         // Each thread simulates one trajectory's particles; every trajectory's moments are kept.
         let threads = crate::threads::current_threads();
         let moments = 4.0 * (ds.len() * ds.n_samples() * c.n_state) as f64 * 8.0;
-        crate::resources::check_memory(
-            "particles",
-            particles,
-            resources::particle_bytes(particles * threads, 2, c.n_state, c.n_inducing) + moments,
-        )?;
+        resources::check_prediction(c, particles, threads, moments)?;
         let history = training_record(model)
             .ok()
             .map(|r| r.history)
