@@ -76,6 +76,10 @@ fn bad_outputs_are_refused_before_any_work() {
     let ballbeam =
         Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/data/sysid/ballbeam.csv");
     let jpg = d.join("x.jpg");
+    let run = d.join("run");
+    std::fs::create_dir_all(run.join("summary.json")).unwrap();
+    let in_folder = run.join("predictions.npz");
+    std::fs::copy(&data, &in_folder).unwrap();
     let is_input = "is the input";
     let cases: Vec<(Vec<&str>, Vec<&str>)> = vec![
         (vec!["dataset", "export", ds, "--csv", ds], vec![is_input]),
@@ -145,6 +149,23 @@ fn bad_outputs_are_refused_before_any_work() {
             vec!["is not a directory"],
         ),
         (vec!["demo", "--out", ds], vec!["is not a directory"]),
+        // A file the job writes inside its folder: an input, or an existing directory.
+        (
+            vec![
+                "evaluate",
+                "--dataset",
+                s(&in_folder),
+                "--prssm",
+                m,
+                "--out",
+                s(&run),
+            ],
+            vec!["predictions.npz: is the input"],
+        ),
+        (
+            vec!["demo", "--out", s(&run)],
+            vec!["summary.json", "is a directory"],
+        ),
         (
             vec![
                 "sysid",
@@ -183,6 +204,36 @@ fn bad_outputs_are_refused_before_any_work() {
         ]);
         assert!(link.symlink_metadata().unwrap().file_type().is_symlink());
         assert_eq!(&std::fs::read(&target).unwrap()[..2], b"PK");
+
+        // So is a figure's.
+        let figure = d.join("figure.png");
+        std::fs::write(&figure, b"old").unwrap();
+        let figure_link = d.join("link.png");
+        std::os::unix::fs::symlink(&figure, &figure_link).unwrap();
+        ok(&[
+            "sysid",
+            s(&ballbeam),
+            "--input",
+            "u",
+            "--output",
+            "y",
+            "--seeds",
+            "1",
+            "--restarts",
+            "1",
+            "--iterations",
+            "5",
+            "--plot",
+            s(&figure_link),
+        ]);
+        assert!(
+            figure_link
+                .symlink_metadata()
+                .unwrap()
+                .file_type()
+                .is_symlink()
+        );
+        assert_eq!(&std::fs::read(&figure).unwrap()[1..4], b"PNG");
     }
 }
 

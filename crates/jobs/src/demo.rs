@@ -43,6 +43,19 @@ use crate::simulate::simulate;
 use crate::train::{TrainingOptions, TrainingPlan, train_prssm};
 use flapssm_analysis::stats::{Interval, median};
 
+/// The files [`run_demo`] writes in its output folder, besides `eval/`
+/// ([`crate::evaluate::EVALUATION_FILES`]); checked before any work by
+/// [`crate::files::check_output_dir`].
+pub const DEMO_FILES: [&str; 7] = [
+    "stages.json",
+    "dataset.npz",
+    "lrqsm.json",
+    "prssm.json",
+    "prssm.last.json",
+    "prssm.ckpt.json",
+    "summary.json",
+];
+
 /// Format tag of `summary.json`.
 pub const SUMMARY_FORMAT: &str = "flapssm-demo-summary";
 /// Target of the default configuration: PR-SSM test RMSE ≤ this × LRQSM's on every output.

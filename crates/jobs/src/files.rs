@@ -89,15 +89,25 @@ pub fn check_figure_output(path: &Path, inputs: &[&Path]) -> Result<()> {
     check_outputs(&[path], inputs)
 }
 
-/// Checks, before any work, that `dir` can be an output directory: an existing directory or a
-/// new name in an existing one.
+/// Checks, before any work, that `dir` can be an output directory (an existing directory or a
+/// new name in an existing one) and that the files the job will write in it, `files` (names
+/// relative to `dir`), pass [`check_outputs`] against `inputs`: none is one of the inputs, a
+/// directory, a device or a dangling link.
 ///
 /// # Errors
-/// [`JobError::Output`] for an existing non-directory or a missing parent.
-pub fn check_output_dir(dir: &Path) -> Result<()> {
+/// [`JobError::Output`] for an existing non-directory, a missing parent or a refused file.
+pub fn check_output_dir(dir: &Path, files: &[&str], inputs: &[&Path]) -> Result<()> {
     let refuse = |why: String| Err(JobError::Output(refused(dir, &why)));
     match std::fs::metadata(dir) {
-        Ok(m) if m.is_dir() => Ok(()),
+        Ok(m) if m.is_dir() => {
+            let paths: Vec<_> = files.iter().map(|f| dir.join(f)).collect();
+            let existing: Vec<&Path> = paths
+                .iter()
+                .map(|p| p.as_path())
+                .filter(|p| p.parent().is_some_and(Path::is_dir))
+                .collect();
+            check_outputs(&existing, inputs)
+        }
         Ok(_) => refuse("exists and is not a directory".into()),
         Err(_) => match dir.parent().filter(|p| !p.as_os_str().is_empty()) {
             Some(p) if !p.is_dir() => refuse(format!("directory {} does not exist", p.display())),

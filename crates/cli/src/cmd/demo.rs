@@ -5,7 +5,9 @@ use std::path::PathBuf;
 use anyhow::Context;
 use clap::Args;
 use flapssm_jobs::JobError;
-use flapssm_jobs::demo::{DemoConfig, run_demo};
+use flapssm_jobs::demo::{DEMO_FILES, DemoConfig, run_demo};
+use flapssm_jobs::evaluate::EVALUATION_FILES;
+use flapssm_jobs::files::check_output_dir;
 
 use crate::progress::{Bars, stop_flag};
 
@@ -45,7 +47,10 @@ pub struct DemoArgs {
 
 /// Runs `flapssm demo`.
 pub fn run(args: DemoArgs) -> anyhow::Result<()> {
-    flapssm_jobs::files::check_output_dir(&args.out)?;
+    check_output_dir(&args.out, &DEMO_FILES, &[])?;
+    if args.out.is_dir() {
+        check_output_dir(&args.out.join("eval"), &EVALUATION_FILES, &[])?;
+    }
     let mut cfg = if args.full {
         DemoConfig::full(args.seed)
     } else {

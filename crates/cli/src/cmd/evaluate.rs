@@ -1,10 +1,10 @@
 //! `flapssm evaluate`: both models on a dataset → metrics, authority analysis, figures, report.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 use clap::Args;
-use flapssm_jobs::evaluate::{EvalOptions, ReportContext, evaluate};
+use flapssm_jobs::evaluate::{EVALUATION_FILES, EvalOptions, ReportContext, evaluate};
 use flapssm_jobs::models::lrqsm::LrqsmLoadModel;
 use flapssm_jobs::models::prssm::PrssmLoadModel;
 use flapssm_jobs::models::{LoadModel, baseline};
@@ -48,7 +48,12 @@ pub struct EvaluateArgs {
 
 /// Runs `flapssm evaluate`.
 pub fn run(a: EvaluateArgs) -> anyhow::Result<()> {
-    flapssm_jobs::files::check_output_dir(&a.out)?;
+    let inputs: Vec<&Path> = [Some(&a.dataset), a.prssm.as_ref(), a.lrqsm.as_ref()]
+        .into_iter()
+        .flatten()
+        .map(PathBuf::as_path)
+        .collect();
+    flapssm_jobs::files::check_output_dir(&a.out, &EVALUATION_FILES, &inputs)?;
     let opts = EvalOptions {
         particles: a.particles,
         seed: a.seed,

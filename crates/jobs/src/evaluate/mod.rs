@@ -51,6 +51,28 @@ use html::{ReportFigures, html_report};
 use prepared::{ModelTables, Prepared, cycle_errors, pooled, rows, split_metrics};
 use tables::{trajectories_csv, write_predictions};
 
+/// Every file [`evaluate`] may write in its output folder (which are written depends on the
+/// models and the sets); checked before any work by [`crate::files::check_output_dir`].
+pub const EVALUATION_FILES: [&str; 17] = [
+    "metrics.json",
+    "report.html",
+    "trajectories.csv",
+    "predictions.npz",
+    "authority_summary.json",
+    "authority_summary.csv",
+    "authority_peaks.csv",
+    "fig2c_wing_motion.png",
+    "fig3_time_histories.png",
+    "fig4a_histograms_train.png",
+    "fig4a_histograms_test.png",
+    "fig4b_cycle_averages.png",
+    "fig5a_hdr.png",
+    "fig5a_scatter_x1.png",
+    "fig5b_summary.png",
+    "training_loss.png",
+    "training_rmse.png",
+];
+
 /// Display names of the 7 inputs (dataset order).
 pub const INPUT_LABELS: [&str; 7] = ["AoA", "|v|", "a_x", "a_y", "a_z", "dα/dt", "d²α/dt²"];
 /// Display names of the 5 outputs as coefficients.
