@@ -167,9 +167,16 @@ mod tests {
         assert!(check_outputs(&[&out, &d.join("new.json")], &[&input]).is_ok());
         assert_eq!(std::fs::read(&input).unwrap(), b"data");
 
-        assert!(check_output_dir(d).is_ok());
-        assert!(check_output_dir(&d.join("new")).is_ok());
-        assert!(check_output_dir(&input).is_err());
-        assert!(check_output_dir(&d.join("no/such")).is_err());
+        let none: [&Path; 0] = [];
+        assert!(check_output_dir(d, &["metrics.json"], &none).is_ok());
+        assert!(check_output_dir(&d.join("new"), &["wing.npz"], &[&input]).is_ok());
+        assert!(check_output_dir(&input, &[], &none).is_err());
+        assert!(check_output_dir(&d.join("no/such"), &[], &none).is_err());
+        let e = check_output_dir(d, &["metrics.json", "wing.npz"], &[&input])
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("wing.npz: is the input"), "{e}");
+        std::fs::create_dir(d.join("metrics.json")).unwrap();
+        assert!(check_output_dir(d, &["metrics.json"], &none).is_err());
     }
 }
