@@ -97,6 +97,12 @@ impl LoadStream {
         self.n_output
     }
 
+    /// Starts the stream again from `x₀ = 0` with its first draws: the next steps repeat
+    /// those since creation exactly. Allocates nothing.
+    pub fn reset(&mut self) {
+        self.predictor.reset();
+    }
+
     /// Notes for the user (an initial-state rule that inputs alone cannot apply).
     pub fn notes(&self) -> &[String] {
         &self.notes

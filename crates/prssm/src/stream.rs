@@ -53,6 +53,10 @@ pub struct StreamPredictor {
     dy: usize,
     du: usize,
     mean_only: bool,
+    seed: u64,
+    /// The initial state `N(init_mean, diag init_std²)`, for [`Self::reset`].
+    init_mean: Vec<f64>,
+    init_std: Vec<f64>,
 }
 
 impl StreamPredictor {
@@ -77,15 +81,8 @@ impl StreamPredictor {
             )));
         }
         let step = StepPredictor::new(&model.config, &model.params, particles)?;
-        let mut rng = ChaCha8Rng::seed_from_u64(seed);
-        let mut x = vec![0.0; particles * dx];
-        for c in 0..particles {
-            for d in 0..dx {
-                let e: f64 = StandardNormal.sample(&mut rng);
-                x[c * dx + d] = init_mean[d] + init_std[d] * e;
-            }
-        }
-        Ok(Self::assemble(model, step, rng, x, false))
+        let init = (init_mean.to_vec(), init_std.to_vec());
+        Ok(Self::assemble(model, step, particles, seed, init, false))
     }
 
     /// A single trajectory propagated without noise from `init_mean` (`ε = 0`, one particle):
@@ -102,23 +99,25 @@ impl StreamPredictor {
             )));
         }
         let step = StepPredictor::new(&model.config, &model.params, 1)?;
-        let rng = ChaCha8Rng::seed_from_u64(0);
-        Ok(Self::assemble(model, step, rng, init_mean.to_vec(), true))
+        let init = (init_mean.to_vec(), vec![0.0; dx]);
+        Ok(Self::assemble(model, step, 1, 0, init, true))
     }
 
     fn assemble(
         model: &PrssmModel,
         step: StepPredictor,
-        rng: ChaCha8Rng,
-        x: Vec<f64>,
+        particles: usize,
+        seed: u64,
+        (init_mean, init_std): (Vec<f64>, Vec<f64>),
         mean_only: bool,
     ) -> Self {
         let c = &model.config;
-        Self {
+        let n = particles * c.n_state;
+        let mut stream = Self {
             step,
-            rng,
-            eps: vec![0.0; x.len()],
-            x,
+            rng: ChaCha8Rng::seed_from_u64(seed),
+            eps: vec![0.0; n],
+            x: vec![0.0; n],
             u_z: vec![0.0; c.n_input],
             out_mean: vec![0.0; c.n_output],
             out_var: vec![0.0; c.n_output],
@@ -128,6 +127,27 @@ impl StreamPredictor {
             dy: c.n_output,
             du: c.n_input,
             mean_only,
+            seed,
+            init_mean,
+            init_std,
+        };
+        stream.reset();
+        stream
+    }
+
+    /// Starts again from the initial state with the first draws of the seed: the next
+    /// [`Self::step`]s repeat those since creation exactly. Allocates nothing.
+    pub fn reset(&mut self) {
+        self.rng = ChaCha8Rng::seed_from_u64(self.seed);
+        for c in self.x.chunks_exact_mut(self.dx) {
+            for ((x, &m), &s) in c.iter_mut().zip(&self.init_mean).zip(&self.init_std) {
+                let e: f64 = if self.mean_only {
+                    0.0
+                } else {
+                    StandardNormal.sample(&mut self.rng)
+                };
+                *x = m + s * e;
+            }
         }
     }
 

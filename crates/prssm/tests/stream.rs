@@ -130,7 +130,34 @@ fn a_streaming_step_does_not_allocate() {
         let (m, _) = mean_stream.step(&u[t * 7..(t + 1) * 7]).unwrap();
         acc += m[0];
     }
+    stream.reset();
+    mean_stream.reset();
     let after = allocations();
     assert!(acc.is_finite());
     assert_eq!(after - before, 0, "allocations during 98 streaming steps");
+}
+
+#[test]
+fn reset_repeats_the_stream_from_its_first_draws() {
+    let model = model(5, 2, 2, 10, false);
+    let u = inputs(30, 2);
+    let m0 = [0.2, 0.0, -0.1, 0.0, 0.3];
+    let s0 = [0.1; 5];
+    let mut stream = StreamPredictor::new(&model, 9, &m0, &s0, 3).unwrap();
+    let run = |s: &mut StreamPredictor| {
+        (0..30)
+            .flat_map(|t| {
+                let (m, v) = s.step(&u[t * 2..t * 2 + 2]).unwrap();
+                [m.to_vec(), v.to_vec()]
+            })
+            .collect::<Vec<_>>()
+    };
+    let first = run(&mut stream);
+    assert_ne!(first, run(&mut stream), "a stream goes on without reset");
+    stream.reset();
+    assert_eq!(first, run(&mut stream));
+    let mut mean_only = StreamPredictor::mean_propagated(&model, &m0).unwrap();
+    let first = run(&mut mean_only);
+    mean_only.reset();
+    assert_eq!(first, run(&mut mean_only));
 }
