@@ -1,0 +1,219 @@
+//! The streaming predictor: one input sample in, the loads' mean and variance out.
+
+use flapssm_jobs::JobError;
+use flapssm_jobs::stream::{LoadStream, StreamSettings};
+
+use crate::model::FlapssmModel;
+use crate::status::{FlapssmStatus, fail, guard};
+
+/// A streaming predictor (opaque). Its buffers are allocated at creation; stepping and
+/// resetting allocate nothing.
+#[derive(Debug)]
+pub struct FlapssmStream {
+    stream: LoadStream,
+    /// The `float` step's inputs in double precision (`D_u`).
+    u: Vec<f64>,
+}
+
+/// Creates a streaming predictor of `model` with `particles` particles (the paper: 30) and
+/// the draws of `seed`, started from `x₀ = 0`, and stores it in `*out` (to be freed with
+/// [`flapssm_stream_free`]). The stream does not borrow the model: the model may be freed.
+///
+/// Returns `FLAPSSM_STATUS_INVALID_VALUE` for zero particles or more than memory holds,
+/// `FLAPSSM_STATUS_INVALID_MODEL` when the model's `K_mm` does not factorize.
+///
+/// # Safety
+/// `model` is null or a live handle; `out` is null or points to writable storage for a
+/// pointer.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn flapssm_stream_new(
+    model: *const FlapssmModel,
+    particles: usize,
+    seed: u64,
+    out: *mut *mut FlapssmStream,
+) -> FlapssmStatus {
+    guard(|| {
+        // SAFETY: null or live, by the caller's contract.
+        let Some(model) = (unsafe { model.as_ref() }) else {
+            return fail(
+                FlapssmStatus::NullArgument,
+                "flapssm_stream_new: null model",
+            );
+        };
+        if out.is_null() {
+            return fail(FlapssmStatus::NullArgument, "flapssm_stream_new: null out");
+        }
+        let settings = StreamSettings { particles, seed };
+        match LoadStream::new(&model.model, &settings) {
+            Ok(stream) => {
+                let u = vec![0.0; stream.n_input()];
+                let handle = Box::into_raw(Box::new(FlapssmStream { stream, u }));
+                // SAFETY: non-null and writable by the caller's contract.
+                unsafe { *out = handle };
+                FlapssmStatus::Ok
+            }
+            Err(e @ (JobError::Setting { .. } | JobError::Mismatch { .. })) => {
+                fail(FlapssmStatus::InvalidValue, e.to_string())
+            }
+            Err(e) => fail(FlapssmStatus::InvalidModel, e.to_string()),
+        }
+    })
+}
+
+/// Checks the handle and the lengths of a step.
+fn check_step(
+    stream: Option<&FlapssmStream>,
+    pointers_null: bool,
+    n_input: usize,
+    n_output: usize,
+) -> FlapssmStatus {
+    let Some(s) = stream else {
+        return fail(FlapssmStatus::NullArgument, "step: null stream");
+    };
+    if pointers_null {
+        return fail(
+            FlapssmStatus::NullArgument,
+            "step: null input or output array",
+        );
+    }
+    let (du, dy) = (s.stream.n_input(), s.stream.n_output());
+    if n_input != du || n_output != dy {
+        return fail(
+            FlapssmStatus::Shape,
+            format!(
+                "step: {n_input} inputs and {n_output} outputs given, the model has {du} and {dy}"
+            ),
+        );
+    }
+    FlapssmStatus::Ok
+}
+
+/// Writes the moments of `y_t` into `mean` and `var` (`n_output` = `D_y` each) and advances
+/// the particles with the input `u_t` (`n_input` = `D_u` values). Allocates nothing.
+///
+/// Returns `FLAPSSM_STATUS_SHAPE` for lengths other than the model's,
+/// `FLAPSSM_STATUS_INVALID_VALUE` for a non-finite input (the stream is left unchanged).
+///
+/// # Safety
+/// `stream` is null or a live handle; `u` holds `n_input` readable values and `mean`, `var`
+/// `n_output` writable ones (or are null).
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn flapssm_stream_step(
+    stream: *mut FlapssmStream,
+    u: *const f64,
+    n_input: usize,
+    mean: *mut f64,
+    var: *mut f64,
+    n_output: usize,
+) -> FlapssmStatus {
+    guard(|| {
+        // SAFETY: null or live, by the caller's contract.
+        let s = unsafe { stream.as_mut() };
+        let nulls = u.is_null() || mean.is_null() || var.is_null();
+        let status = check_step(s.as_deref(), nulls, n_input, n_output);
+        let Some(s) = s.filter(|_| status == FlapssmStatus::Ok) else {
+            return status;
+        };
+        // SAFETY: lengths checked against the model; the caller guarantees the storage.
+        let (u, mean, var) = unsafe {
+            (
+                std::slice::from_raw_parts(u, n_input),
+                std::slice::from_raw_parts_mut(mean, n_output),
+                std::slice::from_raw_parts_mut(var, n_output),
+            )
+        };
+        step(&mut s.stream, u, |m, v| {
+            mean.copy_from_slice(m);
+            var.copy_from_slice(v);
+        })
+    })
+}
+
+/// [`flapssm_stream_step`] in single precision: the inputs are widened to `double`, the step
+/// runs in double precision, and the moments are rounded to `float`. Allocates nothing.
+///
+/// # Safety
+/// As [`flapssm_stream_step`], with `float` arrays.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn flapssm_stream_step_f32(
+    stream: *mut FlapssmStream,
+    u: *const f32,
+    n_input: usize,
+    mean: *mut f32,
+    var: *mut f32,
+    n_output: usize,
+) -> FlapssmStatus {
+    guard(|| {
+        // SAFETY: null or live, by the caller's contract.
+        let s = unsafe { stream.as_mut() };
+        let nulls = u.is_null() || mean.is_null() || var.is_null();
+        let status = check_step(s.as_deref(), nulls, n_input, n_output);
+        let Some(s) = s.filter(|_| status == FlapssmStatus::Ok) else {
+            return status;
+        };
+        // SAFETY: lengths checked against the model; the caller guarantees the storage.
+        let (u, mean, var) = unsafe {
+            (
+                std::slice::from_raw_parts(u, n_input),
+                std::slice::from_raw_parts_mut(mean, n_output),
+                std::slice::from_raw_parts_mut(var, n_output),
+            )
+        };
+        s.u.iter_mut().zip(u).for_each(|(d, &v)| *d = f64::from(v));
+        step(&mut s.stream, &s.u, |m, v| {
+            mean.iter_mut().zip(m).for_each(|(d, &x)| *d = x as f32);
+            var.iter_mut().zip(v).for_each(|(d, &x)| *d = x as f32);
+        })
+    })
+}
+
+/// One checked step; `write` receives the moments.
+fn step(stream: &mut LoadStream, u: &[f64], write: impl FnOnce(&[f64], &[f64])) -> FlapssmStatus {
+    if let Some(i) = u.iter().position(|v| !v.is_finite()) {
+        return fail(
+            FlapssmStatus::InvalidValue,
+            format!("step: input {i} is not finite ({})", u[i]),
+        );
+    }
+    match stream.step(u) {
+        Ok((m, v)) => {
+            write(m, v);
+            FlapssmStatus::Ok
+        }
+        Err(e) => fail(FlapssmStatus::InvalidValue, e.to_string()),
+    }
+}
+
+/// Starts the stream again from `x₀ = 0` with its first draws: the next steps repeat those
+/// since creation exactly. Allocates nothing.
+///
+/// # Safety
+/// `stream` is null or a live handle.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn flapssm_stream_reset(stream: *mut FlapssmStream) -> FlapssmStatus {
+    guard(|| {
+        // SAFETY: null or live, by the caller's contract.
+        match unsafe { stream.as_mut() } {
+            Some(s) => {
+                s.stream.reset();
+                FlapssmStatus::Ok
+            }
+            None => fail(
+                FlapssmStatus::NullArgument,
+                "flapssm_stream_reset: null stream",
+            ),
+        }
+    })
+}
+
+/// Frees a stream handle (null is ignored).
+///
+/// # Safety
+/// `stream` is null or a handle from [`flapssm_stream_new`] not freed before.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn flapssm_stream_free(stream: *mut FlapssmStream) {
+    if !stream.is_null() {
+        // SAFETY: a live handle from `Box::into_raw`, by the caller's contract.
+        drop(unsafe { Box::from_raw(stream) });
+    }
+}
