@@ -1,0 +1,133 @@
+"""flapssm from Python: compact probabilistic state-space models of flapping-wing aerodynamics.
+
+numpy arrays in and out (float64). Shapes and units (wing frame, unit span distance):
+
+- ``inputs``  ``(n, T, 7)``: AoA (rad), |v| (m/s), a_x a_y a_z (m/s²), pitch rate (rad/s),
+  pitch acceleration (rad/s²) — :data:`INPUT_NAMES`, :data:`INPUT_UNITS`.
+- ``outputs`` ``(n, T, 5)``: F_x F_y (N), M_x M_y M_z (N·mm) — :data:`OUTPUT_NAMES`.
+- ``euler_rad`` ``(n, T, 3)``: stroke φ, deviation ψ, pitch α (rad).
+
+The work runs in Rust (the ``flapssm-jobs`` application layer, as the ``flapssm`` CLI) with the
+GIL released; errors are ``ValueError`` (bad values, shapes, files of the wrong content),
+``TypeError`` (dtypes), ``FileNotFoundError`` / ``OSError`` (files) and ``KeyboardInterrupt``
+(Ctrl-C during training, after a checkpoint), carrying the CLI's messages.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from typing import Any, Callable, Optional, Union
+
+import numpy as np
+
+from . import _native
+from ._native import INPUT_NAMES, INPUT_UNITS, OUTPUT_NAMES, OUTPUT_UNITS, Stream
+from ._arrays import as_float_array
+
+__all__ = [
+    "INPUT_NAMES",
+    "INPUT_UNITS",
+    "OUTPUT_NAMES",
+    "OUTPUT_UNITS",
+    "Dataset",
+    "dataset_from_arrays",
+    "LRQSM",
+    "PRSSM",
+    "Stream",
+    "simulate",
+    "train",
+    "evaluate",
+    "LRQSMRegressor",
+    "PRSSMRegressor",
+]
+
+PathLike = Union[str, "os.PathLike[str]"]
+Progress = Callable[[str, int, int], Any]
+
+Dataset = _native.Dataset
+LRQSM = _native.Lrqsm
+PRSSM = _native.Prssm
+
+
+def dataset_from_arrays(
+    euler_rad: Any,
+    inputs: Any,
+    outputs: Any = None,
+    n_train: Optional[int] = None,
+    dt_s: float = 0.04,
+    u_ref_m_s: Any = None,
+) -> "_native.Dataset":
+    """A dataset from arrays: ``euler_rad`` ``(n, T, 3)``, ``inputs`` ``(n, T, 7)``,
+    ``outputs`` ``(n, T, 5)`` or None, the first ``n_train`` (default all) for training,
+    sampling period ``dt_s`` (s; the paper's 25 Hz: 0.04), ``u_ref_m_s`` ``(n,)`` (default:
+    the published rule from the stroke and deviation angles)."""
+    e = as_float_array("euler_rad", euler_rad, (None, None, 3))
+    n, t = e.shape[0], e.shape[1]
+    u = as_float_array("inputs", inputs, (n, t, 7))
+    y = None if outputs is None else as_float_array("outputs", outputs, (n, t, 5))
+    r = None if u_ref_m_s is None else as_float_array("u_ref_m_s", u_ref_m_s, (n,))
+    return _native.Dataset.from_arrays(e, u, y, n if n_train is None else int(n_train), float(dt_s), r)
+
+
+def simulate(
+    n: int = 548,
+    seed: int = 0,
+    fidelity: str = "l2",
+    n_train: Optional[int] = None,
+    noise_free: bool = False,
+    flat: bool = False,
+    progress: Optional[Progress] = None,
+) -> "_native.Dataset":
+    """Simulates the virtual wing on ``n`` generated trajectories (``flapssm simulate``):
+    the same seed gives the same dataset as the CLI. ``fidelity``: ``l0`` quasi-steady,
+    ``l1`` unsteady low-order, ``l2`` vortex method. ``progress(stage, position, total)``."""
+    return _native.simulate(int(n), int(seed), fidelity, n_train, noise_free, flat, progress)
+
+
+def train(
+    dataset: "_native.Dataset",
+    out: PathLike,
+    preset: str = "paper",
+    *,
+    dx: Optional[int] = None,
+    inducing: Optional[int] = None,
+    particles: Optional[int] = None,
+    epochs: Optional[int] = None,
+    iterations: Optional[int] = None,
+    batch: Optional[int] = None,
+    lr: Optional[float] = None,
+    seed: int = 0,
+    val_fraction: float = 0.1,
+    checkpoint_every: int = 10,
+    resume: bool = False,
+    progress: Optional[Progress] = None,
+) -> "_native.Prssm":
+    """Trains a PR-SSM (``flapssm train``) on the dataset's training trajectories; writes
+    the best model to ``out``, the last to ``<out>.last.json`` and checkpoints to
+    ``<out>.ckpt.json``. Ctrl-C raises ``KeyboardInterrupt`` after a checkpoint;
+    ``resume=True`` continues from it (a larger budget extends a finished run)."""
+    return _native.train(
+        dataset, os.fspath(out), preset, dx, inducing, particles, epochs, iterations, batch,
+        lr, int(seed), float(val_fraction), int(checkpoint_every), bool(resume), progress,
+    )
+
+
+def evaluate(
+    dataset: "_native.Dataset",
+    out: PathLike,
+    prssm: Optional["_native.Prssm"] = None,
+    lrqsm: Optional["_native.Lrqsm"] = None,
+    particles: int = 30,
+    seed: int = 0,
+    start_sample: int = 93,
+    progress: Optional[Progress] = None,
+) -> dict:
+    """The paper's analyses (``flapssm evaluate``): RMSE per output, standardized-error 95 %
+    intervals, half-stroke averages, control authority of the latent states, figures and
+    ``report.html`` in ``out``; returns ``metrics.json`` as a dict."""
+    text = _native.evaluate(dataset, os.fspath(out), prssm, lrqsm, particles, seed, start_sample, progress)
+    return json.loads(text)
+
+
+from .estimators import LRQSMRegressor, PRSSMRegressor  # noqa: E402  (uses the names above)

@@ -1,0 +1,249 @@
+//! Datasets as numpy arrays, and the virtual wing.
+
+use std::path::PathBuf;
+
+use flapssm_jobs::simulate::SimulateSettings;
+use flapssm_wing::cycles::{U_REF_RADIUS_M, published_u_ref};
+use flapssm_wing::dataset::{Dataset as WingDataset, DatasetMeta, Trajectory, ValidDataset};
+use flapssm_wing::virtual_wing::Fidelity;
+use numpy::{
+    PyArray1, PyArray3, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray3, PyUntypedArrayMethods,
+};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+
+use crate::errors::{job_error, read_error};
+use crate::progress::PyProgress;
+
+/// A validated wing dataset: `n` trajectories of `T` samples, the first `n_train` for
+/// training. Arrays are copies (float64): `euler_rad` `(n, T, 3)` [stroke φ, deviation ψ,
+/// pitch α] (rad); `inputs` `(n, T, 7)` [AoA rad, |v| m/s, a_x a_y a_z m/s², α̇ rad/s,
+/// α̈ rad/s²] in the wing frame at unit span distance; `outputs` `(n, T, 5)` [F_x N, F_y N,
+/// M_x M_y M_z N·mm] in the wing frame, or `None`; `u_ref_m_s` `(n,)`.
+#[pyclass(module = "flapssm._native", frozen)]
+pub struct Dataset {
+    pub(crate) inner: ValidDataset,
+}
+
+fn array3<'py, const K: usize>(
+    py: Python<'py>,
+    ds: &ValidDataset,
+    rows: impl Fn(&Trajectory) -> &[[f64; K]],
+) -> PyResult<Bound<'py, PyArray3<f64>>> {
+    let (n, t) = (ds.len(), ds.n_samples());
+    let flat: Vec<f64> = ds
+        .trajectories
+        .iter()
+        .flat_map(|tr| rows(tr).iter().flatten().copied())
+        .collect();
+    PyArray1::from_vec(py, flat).reshape([n, t, K])
+}
+
+#[pymethods]
+impl Dataset {
+    /// Reads a dataset `.npz` file (`flapssm simulate`'s format).
+    #[staticmethod]
+    fn load(py: Python<'_>, path: PathBuf) -> PyResult<Self> {
+        py.detach(|| WingDataset::load(&path))
+            .map(|inner| Self { inner })
+            .map_err(|e| read_error(&path, format!("dataset {}: {e}", path.display())))
+    }
+
+    /// Writes the dataset `.npz` file atomically.
+    fn save(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
+        flapssm_jobs::files::check_outputs(&[&path], &[]).map_err(|e| job_error(e, None))?;
+        py.detach(|| self.inner.save(&path))
+            .map_err(|e| pyo3::exceptions::PyOSError::new_err(format!("{}: {e}", path.display())))
+    }
+
+    /// A dataset from arrays (checked by the Python layer for dtype and shape; validated
+    /// here: finite values, equal lengths). `u_ref_m_s` defaults to the published rule
+    /// (mean speed at the wing tip over the last full cycle).
+    #[staticmethod]
+    #[pyo3(signature = (euler_rad, inputs, outputs, n_train, dt_s, u_ref_m_s=None))]
+    fn from_arrays(
+        euler_rad: PyReadonlyArray3<'_, f64>,
+        inputs: PyReadonlyArray3<'_, f64>,
+        outputs: Option<PyReadonlyArray3<'_, f64>>,
+        n_train: usize,
+        dt_s: f64,
+        u_ref_m_s: Option<PyReadonlyArray1<'_, f64>>,
+    ) -> PyResult<Self> {
+        let e = euler_rad.as_slice()?;
+        let u = inputs.as_slice()?;
+        let y = outputs.as_ref().map(|o| o.as_slice()).transpose()?;
+        let u_ref = u_ref_m_s.as_ref().map(|r| r.as_slice()).transpose()?;
+        let (n, t) = (euler_rad.shape()[0], euler_rad.shape()[1]);
+        let expect = |name: &str, shape: &[usize], k: usize| {
+            if shape == [n, t, k] {
+                Ok(())
+            } else {
+                Err(PyValueError::new_err(format!(
+                    "{name}: shape {shape:?}, expected ({n}, {t}, {k})"
+                )))
+            }
+        };
+        expect("euler_rad", euler_rad.shape(), 3)?;
+        expect("inputs", inputs.shape(), 7)?;
+        if let Some(o) = &outputs {
+            expect("outputs", o.shape(), 5)?;
+        }
+        if let Some(r) = u_ref.filter(|r| r.len() != n) {
+            return Err(PyValueError::new_err(format!(
+                "u_ref_m_s: {} values, expected {n}",
+                r.len()
+            )));
+        }
+        let mut trajectories = Vec::with_capacity(n);
+        for i in 0..n {
+            let rows = |a: &[f64], k: usize| a[i * t * k..(i + 1) * t * k].to_vec();
+            let euler: Vec<[f64; 3]> = as_rows(&rows(e, 3));
+            let u_ref = match u_ref {
+                Some(r) => r[i],
+                None => {
+                    published_u_ref(&euler, dt_s, U_REF_RADIUS_M)
+                        .map_err(|err| {
+                            PyValueError::new_err(format!("trajectory {i}: U_ref: {err}"))
+                        })?
+                        .0
+                }
+            };
+            trajectories.push(Trajectory {
+                euler_rad: euler,
+                inputs: as_rows(&rows(u, 7)),
+                outputs: y.map(|y| as_rows(&rows(y, 5))),
+                u_ref_m_s: u_ref,
+                family: "arrays".into(),
+            });
+        }
+        let ds = WingDataset {
+            meta: DatasetMeta::new("python arrays", None, serde_json::Value::Null),
+            dt_s,
+            trajectories,
+            n_train,
+        };
+        ValidDataset::new(ds)
+            .map(|inner| Self { inner })
+            .map_err(|e| PyValueError::new_err(format!("dataset: {e}")))
+    }
+
+    /// Trajectories.
+    fn __len__(&self) -> usize {
+        self.inner.len()
+    }
+
+    /// Samples per trajectory.
+    #[getter]
+    fn n_samples(&self) -> usize {
+        self.inner.n_samples()
+    }
+
+    /// Training trajectories (the first ones).
+    #[getter]
+    fn n_train(&self) -> usize {
+        self.inner.n_train
+    }
+
+    /// Sampling period (s).
+    #[getter]
+    fn dt_s(&self) -> f64 {
+        self.inner.dt_s
+    }
+
+    #[getter]
+    fn euler_rad<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray3<f64>>> {
+        array3(py, &self.inner, |t| &t.euler_rad)
+    }
+
+    #[getter]
+    fn inputs<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray3<f64>>> {
+        array3(py, &self.inner, |t| &t.inputs)
+    }
+
+    #[getter]
+    fn outputs<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyArray3<f64>>>> {
+        if !self.inner.has_outputs() {
+            return Ok(None);
+        }
+        array3(py, &self.inner, |t| t.outputs.as_deref().unwrap_or(&[])).map(Some)
+    }
+
+    #[getter]
+    fn u_ref_m_s<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        let v: Vec<f64> = self
+            .inner
+            .trajectories
+            .iter()
+            .map(|t| t.u_ref_m_s)
+            .collect();
+        PyArray1::from_vec(py, v)
+    }
+
+    /// Family label of each trajectory.
+    #[getter]
+    fn families(&self) -> Vec<String> {
+        self.inner
+            .trajectories
+            .iter()
+            .map(|t| t.family.clone())
+            .collect()
+    }
+
+    /// The metadata (wing geometry, fluid, generator, seed, units) as JSON text.
+    #[getter]
+    fn metadata_json(&self) -> String {
+        serde_json::to_string(&self.inner.meta).unwrap_or_default()
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Dataset({} trajectories × {} samples, {} training, dt {} s)",
+            self.inner.len(),
+            self.inner.n_samples(),
+            self.inner.n_train,
+            self.inner.dt_s
+        )
+    }
+}
+
+fn as_rows<const K: usize>(flat: &[f64]) -> Vec<[f64; K]> {
+    flat.chunks_exact(K)
+        .map(|c| std::array::from_fn(|j| c[j]))
+        .collect()
+}
+
+/// Simulates the virtual wing on `n` generated trajectories (`flapssm simulate`).
+#[pyfunction]
+#[pyo3(signature = (n, seed, fidelity, n_train=None, noise_free=false, flat=false, progress=None))]
+#[allow(clippy::too_many_arguments)]
+pub fn simulate(
+    py: Python<'_>,
+    n: usize,
+    seed: u64,
+    fidelity: &str,
+    n_train: Option<usize>,
+    noise_free: bool,
+    flat: bool,
+    progress: Option<Py<PyAny>>,
+) -> PyResult<Dataset> {
+    let fidelity: Fidelity = fidelity
+        .parse()
+        .map_err(|e| PyValueError::new_err(format!("fidelity: {e}")))?;
+    let cfg = SimulateSettings {
+        n_trajectories: n,
+        n_train,
+        seed,
+        fidelity,
+        noise_free,
+        flat,
+    }
+    .check()
+    .map_err(|e| job_error(e, None))?;
+    let bar = PyProgress::new(progress);
+    let ds = py.detach(|| flapssm_jobs::simulate::simulate(&cfg, None, &bar));
+    if let Some(e) = bar.take_error() {
+        return Err(e);
+    }
+    ds.map(|inner| Dataset { inner })
+        .map_err(|e| job_error(e, None))
+}

@@ -1,0 +1,77 @@
+//! The evaluation and analyses (`flapssm evaluate`): metrics, intervals, cycle averages,
+//! control authority, figures and the HTML report, returned as the `metrics.json` dict.
+
+use std::path::PathBuf;
+
+use flapssm_jobs::evaluate::{EVALUATION_FILES, EvalOptions, ReportContext};
+use flapssm_jobs::models::LoadModel;
+use flapssm_jobs::models::lrqsm::LrqsmLoadModel;
+use flapssm_jobs::models::prssm::PrssmLoadModel;
+use pyo3::prelude::*;
+
+use crate::dataset::Dataset;
+use crate::errors::job_error;
+use crate::lrqsm::Lrqsm;
+use crate::progress::PyProgress;
+use crate::prssm::Prssm;
+
+/// Evaluates the models on `dataset`, writes the outputs into `out` and returns the
+/// report (`metrics.json`) as JSON text.
+#[pyfunction]
+#[pyo3(signature = (dataset, out, prssm=None, lrqsm=None, particles=30, seed=0, start_sample=93, progress=None))]
+#[allow(clippy::too_many_arguments)]
+pub fn evaluate(
+    py: Python<'_>,
+    dataset: &Dataset,
+    out: PathBuf,
+    prssm: Option<&Prssm>,
+    lrqsm: Option<&Lrqsm>,
+    particles: usize,
+    seed: u64,
+    start_sample: usize,
+    progress: Option<Py<PyAny>>,
+) -> PyResult<String> {
+    flapssm_jobs::files::check_output_dir(&out, &EVALUATION_FILES, &[])
+        .map_err(|e| job_error(e, None))?;
+    let opts = EvalOptions {
+        particles,
+        seed,
+        start_sample,
+        ..EvalOptions::default()
+    };
+    let ds = &dataset.inner;
+    let p = prssm
+        .map(|m| PrssmLoadModel::new(&m.model, ds, particles, seed))
+        .transpose()
+        .map_err(|e| job_error(e, None))?;
+    let l = lrqsm
+        .map(|m| LrqsmLoadModel::new(&m.model))
+        .transpose()
+        .map_err(|e| job_error(e, None))?;
+    let mut models: Vec<&dyn LoadModel> = Vec::new();
+    if let Some(p) = &p {
+        models.push(p);
+    }
+    if let Some(l) = &l {
+        models.push(l);
+    }
+    let bar = PyProgress::new(progress);
+    let report = py
+        .detach(|| {
+            flapssm_jobs::evaluate::evaluate(
+                ds,
+                "python dataset",
+                &models,
+                &opts,
+                &ReportContext::default(),
+                &out,
+                &bar,
+            )
+        })
+        .map_err(|e| job_error(e, None))?;
+    if let Some(e) = bar.take_error() {
+        return Err(e);
+    }
+    serde_json::to_string(&report)
+        .map_err(|e| pyo3::exceptions::PyValueError::new_err(e.to_string()))
+}

@@ -1,0 +1,28 @@
+//! `flapssm._native`: the Rust side of the Python package (see `python/flapssm`). Thin: each
+//! function converts numpy arrays, releases the GIL and calls the application layer
+//! (`flapssm-jobs`); errors become Python exceptions carrying the CLI's messages.
+
+mod dataset;
+mod errors;
+mod evaluate;
+mod lrqsm;
+mod progress;
+mod prssm;
+
+use pyo3::prelude::*;
+
+#[pymodule]
+fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<dataset::Dataset>()?;
+    m.add_class::<lrqsm::Lrqsm>()?;
+    m.add_class::<prssm::Prssm>()?;
+    m.add_class::<prssm::Stream>()?;
+    m.add_function(wrap_pyfunction!(dataset::simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(prssm::train, m)?)?;
+    m.add_function(wrap_pyfunction!(evaluate::evaluate, m)?)?;
+    m.add("INPUT_NAMES", flapssm_wing::dataset::INPUT_NAMES.to_vec())?;
+    m.add("OUTPUT_NAMES", flapssm_wing::dataset::OUTPUT_NAMES.to_vec())?;
+    m.add("INPUT_UNITS", flapssm_wing::dataset::INPUT_UNITS.to_vec())?;
+    m.add("OUTPUT_UNITS", flapssm_wing::dataset::OUTPUT_UNITS.to_vec())?;
+    Ok(())
+}

@@ -1,0 +1,263 @@
+//! The PR-SSM: training, prediction, streaming, model files.
+
+use std::path::PathBuf;
+
+use flapssm_jobs::JobError;
+use flapssm_jobs::stream::{LoadStream, StreamSettings};
+use flapssm_jobs::train::{TrainFiles, TrainingOptions, train_dataset};
+use flapssm_prssm::PrssmModel;
+use numpy::{
+    PyArray1, PyArray2, PyArray3, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2,
+    PyUntypedArrayMethods,
+};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+
+use crate::dataset::Dataset;
+use crate::errors::{job_error, read_error};
+use crate::progress::PyProgress;
+
+/// Arrays of a prediction: output mean, output variance, latent mean.
+type Moments<'py, A> = PyResult<(Bound<'py, A>, Bound<'py, A>, Bound<'py, A>)>;
+/// A step's output mean and variance.
+type StepMoments<'py> = PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>)>;
+
+/// A trained PR-SSM (`x_{t+1} = x_t + f(x_t, u_t) + noise`, `y_t = x_t[:D_y] + noise`, `f`
+/// a sparse GP), in the units of its normalization (physical for a wing model).
+#[pyclass(module = "flapssm._native", frozen)]
+pub struct Prssm {
+    pub(crate) model: PrssmModel,
+}
+
+fn prssm_error(what: &str, e: impl std::fmt::Display) -> PyErr {
+    PyValueError::new_err(format!("{what}: {e}"))
+}
+
+#[pymethods]
+impl Prssm {
+    /// Reads a model file (`flapssm train`'s JSON).
+    #[staticmethod]
+    fn load(path: PathBuf) -> PyResult<Self> {
+        PrssmModel::load(&path)
+            .map(|model| Self { model })
+            .map_err(|e| read_error(&path, e.to_string()))
+    }
+
+    /// Imports the authors' published parameters (`.npz`, `flapssm model import-published`).
+    #[staticmethod]
+    fn import_published(path: PathBuf) -> PyResult<Self> {
+        flapssm_prssm::published::import_published(&path)
+            .map(|model| Self { model })
+            .map_err(|e| read_error(&path, e.to_string()))
+    }
+
+    /// Writes the model file atomically.
+    fn save(&self, path: PathBuf) -> PyResult<()> {
+        flapssm_jobs::files::check_outputs(&[&path], &[]).map_err(|e| job_error(e, None))?;
+        self.model
+            .save(&path)
+            .map_err(|e| pyo3::exceptions::PyOSError::new_err(e.to_string()))
+    }
+
+    #[getter]
+    fn n_state(&self) -> usize {
+        self.model.config.n_state
+    }
+
+    #[getter]
+    fn n_input(&self) -> usize {
+        self.model.config.n_input
+    }
+
+    #[getter]
+    fn n_output(&self) -> usize {
+        self.model.config.n_output
+    }
+
+    #[getter]
+    fn n_inducing(&self) -> usize {
+        self.model.config.n_inducing
+    }
+
+    /// Open-loop prediction from inputs `(T, D_u)` (`flapssm predict --inputs`): from
+    /// `x₀ = 0`, draws of `prediction_seed(seed, 0)`. Returns output mean and variance
+    /// `(T, D_y)` and latent mean `(T, D_x)` (standardized units).
+    #[pyo3(signature = (inputs, particles=30, seed=0))]
+    fn predict_inputs<'py>(
+        &self,
+        py: Python<'py>,
+        inputs: PyReadonlyArray2<'py, f64>,
+        particles: usize,
+        seed: u64,
+    ) -> Moments<'py, PyArray2<f64>> {
+        let (t, du) = (inputs.shape()[0], inputs.shape()[1]);
+        let u = inputs.as_slice()?.to_vec();
+        let p = py
+            .detach(|| flapssm_jobs::predict::predict_inputs(&self.model, &u, du, particles, seed))
+            .map_err(|e| job_error(e, None))?
+            .prediction;
+        let (dy, dx) = (self.model.config.n_output, self.model.config.n_state);
+        Ok((
+            PyArray1::from_vec(py, p.output_mean).reshape([t, dy])?,
+            PyArray1::from_vec(py, p.output_var).reshape([t, dy])?,
+            PyArray1::from_vec(py, p.latent_mean).reshape([t, dx])?,
+        ))
+    }
+
+    /// Prediction of every trajectory of a dataset (`flapssm predict MODEL DATASET`):
+    /// trajectory `i` drawn with `prediction_seed(seed, i)`. Returns output mean and variance
+    /// `(n, T, 5)` (N, N·mm) and latent mean `(n, T, D_x)`.
+    #[pyo3(signature = (dataset, particles=30, seed=0, progress=None))]
+    fn predict_dataset<'py>(
+        &self,
+        py: Python<'py>,
+        dataset: &Dataset,
+        particles: usize,
+        seed: u64,
+        progress: Option<Py<PyAny>>,
+    ) -> Moments<'py, PyArray3<f64>> {
+        let bar = PyProgress::new(progress);
+        let ds = &dataset.inner;
+        let preds = py
+            .detach(|| flapssm_jobs::predict::predict_prssm(&self.model, ds, particles, seed, &bar))
+            .map_err(|e| job_error(e, None))?;
+        if let Some(e) = bar.take_error() {
+            return Err(e);
+        }
+        let (n, t, dx) = (ds.len(), ds.n_samples(), self.model.config.n_state);
+        let cat = |f: fn(&flapssm_prssm::predict::Prediction) -> &Vec<f64>| {
+            preds
+                .iter()
+                .flat_map(|p| f(p).iter().copied())
+                .collect::<Vec<_>>()
+        };
+        Ok((
+            PyArray1::from_vec(py, cat(|p| &p.output_mean)).reshape([n, t, 5])?,
+            PyArray1::from_vec(py, cat(|p| &p.output_var)).reshape([n, t, 5])?,
+            PyArray1::from_vec(py, cat(|p| &p.latent_mean)).reshape([n, t, dx])?,
+        ))
+    }
+
+    /// A streaming predictor (`flapssm stream`): equal to `predict_inputs` step by step.
+    #[pyo3(signature = (particles=30, seed=0))]
+    fn stream(&self, particles: usize, seed: u64) -> PyResult<Stream> {
+        let stream = LoadStream::new(&self.model, &StreamSettings { particles, seed })
+            .map_err(|e| job_error(e, None))?;
+        Ok(Stream { stream })
+    }
+
+    /// The model file's JSON text.
+    fn to_json(&self) -> PyResult<String> {
+        serde_json::to_string(&self.model).map_err(|e| prssm_error("model", e))
+    }
+
+    fn __repr__(&self) -> String {
+        let c = &self.model.config;
+        format!(
+            "Prssm(D_x {}, D_u {}, D_y {}, M {})",
+            c.n_state, c.n_input, c.n_output, c.n_inducing
+        )
+    }
+}
+
+/// One input sample in, the loads' mean and variance out (allocation-free per step).
+#[pyclass(module = "flapssm._native")]
+pub struct Stream {
+    stream: LoadStream,
+}
+
+#[pymethods]
+impl Stream {
+    /// The moments of `y_t` (mean, variance; `(D_y,)` each), then the particles advanced by
+    /// `u_t` (`(D_u,)`).
+    fn step<'py>(&mut self, py: Python<'py>, u: PyReadonlyArray1<'py, f64>) -> StepMoments<'py> {
+        let (m, v) = self
+            .stream
+            .step(u.as_slice()?)
+            .map_err(|e| job_error(e, None))?;
+        Ok((PyArray1::from_slice(py, m), PyArray1::from_slice(py, v)))
+    }
+
+    /// Starts again from `x₀ = 0` with the first draws.
+    fn reset(&mut self) {
+        self.stream.reset();
+    }
+
+    #[getter]
+    fn n_input(&self) -> usize {
+        self.stream.n_input()
+    }
+
+    #[getter]
+    fn n_output(&self) -> usize {
+        self.stream.n_output()
+    }
+}
+
+/// Trains a PR-SSM on the training trajectories of `dataset` (`flapssm train`), writing the
+/// best model to `out`, the last to `<out>.last.json` and checkpoints to `<out>.ckpt.json`.
+/// Returns the best model. Ctrl-C (or an exception of `progress`) stops at the next step
+/// with a checkpoint; `resume=True` continues from it.
+#[pyfunction]
+#[pyo3(signature = (dataset, out, preset="paper", dx=None, inducing=None, particles=None,
+    epochs=None, iterations=None, batch=None, lr=None, seed=0, val_fraction=0.1,
+    checkpoint_every=10, resume=false, progress=None))]
+#[allow(clippy::too_many_arguments)]
+pub fn train(
+    py: Python<'_>,
+    dataset: &Dataset,
+    out: PathBuf,
+    preset: &str,
+    dx: Option<usize>,
+    inducing: Option<usize>,
+    particles: Option<usize>,
+    epochs: Option<u64>,
+    iterations: Option<u64>,
+    batch: Option<usize>,
+    lr: Option<f64>,
+    seed: u64,
+    val_fraction: f64,
+    checkpoint_every: u64,
+    resume: bool,
+    progress: Option<Py<PyAny>>,
+) -> PyResult<Prssm> {
+    let plan = TrainingOptions {
+        preset: preset
+            .parse()
+            .map_err(|e: String| PyValueError::new_err(format!("preset: {e}")))?,
+        dx,
+        inducing,
+        particles,
+        epochs,
+        iterations,
+        batch,
+        lr,
+        schedule: None,
+        eval_every: None,
+        seed,
+        val_fraction,
+        checkpoint_every,
+    }
+    .check()
+    .map_err(|e| job_error(e, None))?;
+    let files = TrainFiles::beside(&out, None);
+    flapssm_jobs::files::check_outputs(&[&files.model, &files.last, &files.checkpoint], &[])
+        .map_err(|e| job_error(e, None))?;
+    let bar = PyProgress::new(progress);
+    let result =
+        py.detach(|| train_dataset(&dataset.inner, &plan, &files, resume, &bar, Some(&bar.stop)));
+    let pending = bar.take_error();
+    match result {
+        Ok(_) => Prssm::load(files.model),
+        Err(e @ JobError::Interrupted { .. }) => {
+            let message = format!("{e}; call train(..., resume=True) to continue");
+            match pending {
+                Some(err) if !err.is_instance_of::<pyo3::exceptions::PyKeyboardInterrupt>(py) => {
+                    Err(err)
+                }
+                _ => Err(pyo3::exceptions::PyKeyboardInterrupt::new_err(message)),
+            }
+        }
+        Err(e) => Err(pending.unwrap_or_else(|| job_error(e, None))),
+    }
+}

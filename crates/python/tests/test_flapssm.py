@@ -1,0 +1,148 @@
+"""The Python package against the CLI, the files and itself."""
+
+import os
+import signal
+
+import numpy as np
+import pytest
+
+import flapssm
+
+
+@pytest.fixture(scope="module")
+def small():
+    return flapssm.simulate(4, seed=3, fidelity="l0", n_train=3)
+
+
+def test_dataset_round_trips_through_files_and_arrays(small, tmp_path):
+    path = tmp_path / "wing.npz"
+    small.save(path)
+    back = flapssm.Dataset.load(path)
+    for name in ["euler_rad", "inputs", "outputs", "u_ref_m_s"]:
+        assert np.array_equal(getattr(back, name), getattr(small, name)), name
+    assert (len(back), back.n_samples, back.n_train, back.dt_s) == (4, 470, 3, 0.04)
+    assert small.inputs.shape == (4, 470, 7) and small.inputs.dtype == np.float64
+
+    made = flapssm.dataset_from_arrays(small.euler_rad, small.inputs, small.outputs, n_train=3,
+                                       u_ref_m_s=small.u_ref_m_s)
+    made.save(tmp_path / "made.npz")
+    again = flapssm.Dataset.load(tmp_path / "made.npz")
+    assert np.array_equal(again.outputs, small.outputs)
+    # U_ref by the published rule when not given: the simulator's own value.
+    derived = flapssm.dataset_from_arrays(small.euler_rad, small.inputs, small.outputs)
+    assert np.allclose(derived.u_ref_m_s, small.u_ref_m_s, rtol=1e-12)
+
+
+def test_simulation_equals_the_cli(cli, small, tmp_path):
+    out = tmp_path / "cli.npz"
+    cli("simulate", "--n", 4, "--n-train", 3, "--seed", 3, "--fidelity", "l0", "--quiet", "--out", out)
+    from_cli = flapssm.Dataset.load(out)
+    for name in ["euler_rad", "inputs", "outputs", "u_ref_m_s"]:
+        assert np.array_equal(getattr(from_cli, name), getattr(small, name)), name
+
+
+def test_prediction_equals_the_cli_and_the_stream(cli, published, tmp_path):
+    model = flapssm.PRSSM.import_published(published)
+    u = np.load(published)["u_in"]
+    csv = tmp_path / "u.csv"
+    np.savetxt(csv, u, delimiter=",", header=",".join(flapssm.INPUT_NAMES), comments="", fmt="%.17g")
+    model.save(tmp_path / "m.json")
+    cli("predict", tmp_path / "m.json", "--inputs", csv, "--seed", 5, "--out", tmp_path / "p.csv")
+    table = np.loadtxt(tmp_path / "p.csv", delimiter=",", skiprows=1)
+    mean, var, latent = model.predict_inputs(u, particles=30, seed=5)
+    assert mean.shape == (470, 5) and latent.shape == (470, 12)
+    assert np.allclose(table[:, 1:6], mean, rtol=1e-15, atol=0)
+    assert np.allclose(table[:, 6:11], var, rtol=1e-15, atol=0)
+
+    stream = model.stream(particles=30, seed=5)
+    for t in range(470):
+        m, v = stream.step(u[t])
+        assert np.array_equal(m, mean[t]) and np.array_equal(v, var[t]), t
+    stream.reset()
+    m0, _ = stream.step(u[0])
+    assert np.array_equal(m0, mean[0])
+    with pytest.raises(ValueError, match="expected 7"):
+        stream.step(u[0, :6].copy())
+
+
+def test_bad_input_raises_the_right_exception(small, tmp_path):
+    with pytest.raises(FileNotFoundError, match="missing.npz"):
+        flapssm.Dataset.load(tmp_path / "missing.npz")
+    with pytest.raises(FileNotFoundError):
+        flapssm.PRSSM.load(tmp_path / "missing.json")
+    garbage = tmp_path / "garbage.npz"
+    garbage.write_text("not a dataset")
+    with pytest.raises(ValueError, match="garbage.npz"):
+        flapssm.Dataset.load(garbage)
+    with pytest.raises(ValueError, match=r"inputs: shape \(4, 470, 6\), expected \(4, 470, 7\)"):
+        flapssm.dataset_from_arrays(small.euler_rad, small.inputs[:, :, :6])
+    with pytest.raises(TypeError, match="dtype"):
+        flapssm.dataset_from_arrays(small.euler_rad.astype(str), small.inputs)
+    nan = small.inputs.copy()
+    nan[1, 7, 2] = np.nan
+    with pytest.raises(ValueError, match=r"non-finite value at index \(1, 7, 2\)"):
+        flapssm.dataset_from_arrays(small.euler_rad, nan)
+    with pytest.raises(ValueError, match="fidelity"):
+        flapssm.simulate(2, fidelity="l9")
+    with pytest.raises(ValueError, match="n_train"):
+        flapssm.simulate(2, n_train=5)
+    with pytest.raises(ValueError, match="preset"):
+        flapssm.train(small, tmp_path / "m.json", preset="fast")
+    with pytest.raises(OSError, match="is a directory"):
+        small.save(tmp_path)
+
+
+def _tiny(small, out, **kw):
+    return flapssm.train(small, out, "sysid", dx=5, inducing=8, particles=4, batch=2, epochs=6,
+                         checkpoint_every=0, seed=2, **kw)
+
+
+def test_keyboard_interrupt_leaves_a_resumable_checkpoint(small, tmp_path):
+    whole = _tiny(small, tmp_path / "whole.json")
+    calls = []
+
+    def interrupt(stage, position, total):
+        calls.append(position)
+        if position == 3 and total > 0:
+            signal.raise_signal(signal.SIGINT)
+
+    out = tmp_path / "m.json"
+    with pytest.raises(KeyboardInterrupt, match="resume"):
+        _tiny(small, out, progress=interrupt)
+    assert (tmp_path / "m.ckpt.json").exists() and not out.exists()
+    assert not [f for f in os.listdir(tmp_path) if f.endswith(".tmp")]
+    resumed = _tiny(small, out, resume=True)
+    assert resumed.to_json() == whole.to_json()
+    assert len(calls) > 3
+
+
+def test_estimators_follow_scikit_learn_conventions(small):
+    est = flapssm.LRQSMRegressor(n_folds=3)
+    assert est.get_params()["n_folds"] == 3
+    assert est.set_params(n_folds=4) is est and est.n_folds == 4
+    with pytest.raises(ValueError, match="invalid parameter"):
+        est.set_params(bogus=1)
+    with pytest.raises(ValueError, match="not fitted"):
+        est.predict(small)
+    est.fit(small.inputs, small.outputs, euler_rad=small.euler_rad)
+    assert est.coef_.shape == (5, 11) and est.lambda_.shape == (5,)
+    pred = est.predict(small.inputs, euler_rad=small.euler_rad)
+    same = flapssm.dataset_from_arrays(small.euler_rad, small.inputs, small.outputs)
+    assert np.array_equal(pred, flapssm.LRQSM.fit(same, n_folds=4).predict(same))
+    clone = type(est)(**est.get_params())
+    assert not hasattr(clone, "model_") and clone.get_params() == est.get_params()
+
+    prssm = flapssm.PRSSMRegressor(preset="sysid", dx=5, inducing=8, particles=4, batch=2, epochs=2,
+                                   predict_particles=5)
+    mean, std = prssm.fit(small).predict(small, return_std=True)
+    assert mean.shape == (4, 470, 5) and (std > 0).all() and prssm.n_state_ == 5
+
+
+def test_evaluate_returns_the_metrics(small, tmp_path):
+    lrqsm = flapssm.LRQSM.fit(small, n_folds=3)
+    model = _tiny(small, tmp_path / "m.json")
+    report = flapssm.evaluate(small, tmp_path / "eval", prssm=model, lrqsm=lrqsm, particles=5)
+    names = [m["model"] for m in report["models"]]
+    assert names == ["PR-SSM", "LRQSM"]
+    assert (tmp_path / "eval" / "metrics.json").exists()
+    assert report["authority_findings"] is not None
