@@ -60,32 +60,50 @@ pub unsafe extern "C" fn flapssm_stream_new(
     })
 }
 
-/// Checks the handle and the lengths of a step.
-fn check_step(
-    stream: Option<&FlapssmStream>,
-    pointers_null: bool,
+/// Checks the handle, the pointers and the lengths of a step, then runs `body` on the stream
+/// and the arrays as slices.
+///
+/// # Safety
+/// As [`flapssm_stream_step`].
+unsafe fn with_arrays<T>(
+    stream: *mut FlapssmStream,
+    u: *const T,
     n_input: usize,
+    mean: *mut T,
+    var: *mut T,
     n_output: usize,
+    body: impl FnOnce(&mut FlapssmStream, &[T], &mut [T], &mut [T]) -> FlapssmStatus,
 ) -> FlapssmStatus {
-    let Some(s) = stream else {
-        return fail(FlapssmStatus::NullArgument, "step: null stream");
-    };
-    if pointers_null {
-        return fail(
-            FlapssmStatus::NullArgument,
-            "step: null input or output array",
-        );
-    }
-    let (du, dy) = (s.stream.n_input(), s.stream.n_output());
-    if n_input != du || n_output != dy {
-        return fail(
-            FlapssmStatus::Shape,
-            format!(
-                "step: {n_input} inputs and {n_output} outputs given, the model has {du} and {dy}"
-            ),
-        );
-    }
-    FlapssmStatus::Ok
+    guard(|| {
+        // SAFETY: null or live, by the caller's contract.
+        let Some(s) = (unsafe { stream.as_mut() }) else {
+            return fail(FlapssmStatus::NullArgument, "step: null stream");
+        };
+        if u.is_null() || mean.is_null() || var.is_null() {
+            return fail(
+                FlapssmStatus::NullArgument,
+                "step: null input or output array",
+            );
+        }
+        let (du, dy) = (s.stream.n_input(), s.stream.n_output());
+        if n_input != du || n_output != dy {
+            return fail(
+                FlapssmStatus::Shape,
+                format!(
+                    "step: {n_input} inputs and {n_output} outputs given, the model has {du} and {dy}"
+                ),
+            );
+        }
+        // SAFETY: lengths checked against the model; the caller guarantees the storage.
+        let (u, mean, var) = unsafe {
+            (
+                std::slice::from_raw_parts(u, n_input),
+                std::slice::from_raw_parts_mut(mean, n_output),
+                std::slice::from_raw_parts_mut(var, n_output),
+            )
+        };
+        body(s, u, mean, var)
+    })
 }
 
 /// Writes the moments of `y_t` into `mean` and `var` (`n_output` = `D_y` each) and advances
@@ -106,27 +124,23 @@ pub unsafe extern "C" fn flapssm_stream_step(
     var: *mut f64,
     n_output: usize,
 ) -> FlapssmStatus {
-    guard(|| {
-        // SAFETY: null or live, by the caller's contract.
-        let s = unsafe { stream.as_mut() };
-        let nulls = u.is_null() || mean.is_null() || var.is_null();
-        let status = check_step(s.as_deref(), nulls, n_input, n_output);
-        let Some(s) = s.filter(|_| status == FlapssmStatus::Ok) else {
-            return status;
-        };
-        // SAFETY: lengths checked against the model; the caller guarantees the storage.
-        let (u, mean, var) = unsafe {
-            (
-                std::slice::from_raw_parts(u, n_input),
-                std::slice::from_raw_parts_mut(mean, n_output),
-                std::slice::from_raw_parts_mut(var, n_output),
-            )
-        };
-        step(&mut s.stream, u, |m, v| {
-            mean.copy_from_slice(m);
-            var.copy_from_slice(v);
-        })
-    })
+    // SAFETY: forwarded caller contract.
+    unsafe {
+        with_arrays(
+            stream,
+            u,
+            n_input,
+            mean,
+            var,
+            n_output,
+            |s, u, mean, var| {
+                step(&mut s.stream, u, |m, v| {
+                    mean.copy_from_slice(m);
+                    var.copy_from_slice(v);
+                })
+            },
+        )
+    }
 }
 
 /// [`flapssm_stream_step`] in single precision: the inputs are widened to `double`, the step
@@ -143,28 +157,24 @@ pub unsafe extern "C" fn flapssm_stream_step_f32(
     var: *mut f32,
     n_output: usize,
 ) -> FlapssmStatus {
-    guard(|| {
-        // SAFETY: null or live, by the caller's contract.
-        let s = unsafe { stream.as_mut() };
-        let nulls = u.is_null() || mean.is_null() || var.is_null();
-        let status = check_step(s.as_deref(), nulls, n_input, n_output);
-        let Some(s) = s.filter(|_| status == FlapssmStatus::Ok) else {
-            return status;
-        };
-        // SAFETY: lengths checked against the model; the caller guarantees the storage.
-        let (u, mean, var) = unsafe {
-            (
-                std::slice::from_raw_parts(u, n_input),
-                std::slice::from_raw_parts_mut(mean, n_output),
-                std::slice::from_raw_parts_mut(var, n_output),
-            )
-        };
-        s.u.iter_mut().zip(u).for_each(|(d, &v)| *d = f64::from(v));
-        step(&mut s.stream, &s.u, |m, v| {
-            mean.iter_mut().zip(m).for_each(|(d, &x)| *d = x as f32);
-            var.iter_mut().zip(v).for_each(|(d, &x)| *d = x as f32);
-        })
-    })
+    // SAFETY: forwarded caller contract.
+    unsafe {
+        with_arrays(
+            stream,
+            u,
+            n_input,
+            mean,
+            var,
+            n_output,
+            |s, u, mean, var| {
+                s.u.iter_mut().zip(u).for_each(|(d, &v)| *d = f64::from(v));
+                step(&mut s.stream, &s.u, |m, v| {
+                    mean.iter_mut().zip(m).for_each(|(d, &x)| *d = x as f32);
+                    var.iter_mut().zip(v).for_each(|(d, &x)| *d = x as f32);
+                })
+            },
+        )
+    }
 }
 
 /// One checked step; `write` receives the moments.
