@@ -247,3 +247,57 @@ pub fn simulate(
     ds.map(|inner| Dataset { inner })
         .map_err(|e| job_error(e, None))
 }
+
+/// Generates `n` random wing trajectories (`flapssm trajectories`): a kinematics-only
+/// dataset (no outputs), the same for the same seed as the CLI.
+#[pyfunction]
+#[pyo3(signature = (n, seed, n_train=None))]
+pub fn trajectories(
+    py: Python<'_>,
+    n: usize,
+    seed: u64,
+    n_train: Option<usize>,
+) -> PyResult<Dataset> {
+    use flapssm_wing::trajectories::{GeneratorConfig, default_n_train, kinematics_dataset};
+    let cfg = GeneratorConfig {
+        n_trajectories: n,
+        n_train: n_train.unwrap_or_else(|| default_n_train(n)),
+        seed,
+        ..GeneratorConfig::default()
+    };
+    flapssm_jobs::resources::check_dataset("n", n, cfg.sampling.n_samples)
+        .map_err(|e| job_error(e, None))?;
+    py.detach(|| kinematics_dataset(&cfg))
+        .map(|inner| Dataset { inner })
+        .map_err(|e| PyValueError::new_err(format!("trajectories: {e}")))
+}
+
+/// The wing-frame inputs `(T, 7)` of measured Euler angles `(T, 3)` (rad) sampled every
+/// `dt_s`: Savitzky–Golay angles, rates and accelerations (window `2·half_window + 1`,
+/// default the 0.48 s span of the virtual sensor chain's differentiator; degree `order`,
+/// default 6), then the wing kinematics at unit span distance.
+#[pyfunction]
+#[pyo3(signature = (euler_rad, dt_s, half_window=None, order=None))]
+pub fn kinematics<'py>(
+    py: Python<'py>,
+    euler_rad: numpy::PyReadonlyArray2<'py, f64>,
+    dt_s: f64,
+    half_window: Option<usize>,
+    order: Option<usize>,
+) -> PyResult<Bound<'py, numpy::PyArray2<f64>>> {
+    use flapssm_wing::differentiate::{SavitzkyGolayConfig, measured_inputs};
+    let mut cfg = SavitzkyGolayConfig::spanning_default(dt_s);
+    if let Some(m) = half_window {
+        cfg.half_window = m;
+    }
+    if let Some(p) = order {
+        cfg.order = p;
+    }
+    let angles: Vec<[f64; 3]> = as_rows(euler_rad.as_slice()?);
+    let t = angles.len();
+    let inputs = py
+        .detach(|| measured_inputs(&angles, dt_s, cfg))
+        .map_err(|e| PyValueError::new_err(format!("kinematics: {e}")))?;
+    let flat: Vec<f64> = inputs.iter().flatten().copied().collect();
+    PyArray1::from_vec(py, flat).reshape([t, 7])
+}

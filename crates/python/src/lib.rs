@@ -8,6 +8,7 @@ mod evaluate;
 mod lrqsm;
 mod progress;
 mod prssm;
+mod sysid;
 
 use pyo3::prelude::*;
 
@@ -18,6 +19,9 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<prssm::Prssm>()?;
     m.add_class::<prssm::Stream>()?;
     m.add_function(wrap_pyfunction!(dataset::simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(dataset::trajectories, m)?)?;
+    m.add_function(wrap_pyfunction!(dataset::kinematics, m)?)?;
+    m.add_function(wrap_pyfunction!(sysid::sysid, m)?)?;
     m.add_function(wrap_pyfunction!(prssm::train, m)?)?;
     m.add_function(wrap_pyfunction!(evaluate::evaluate, m)?)?;
     m.add("INPUT_NAMES", flapssm_wing::dataset::INPUT_NAMES.to_vec())?;

@@ -10,6 +10,7 @@ use flapssm_wing::features::FeatureSet;
 use numpy::{PyArray1, PyArray2, PyArray3, PyArrayMethods};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
+use pyo3::types::PyDict;
 
 use crate::dataset::Dataset;
 use crate::errors::{job_error, read_error};
@@ -135,6 +136,36 @@ impl Lrqsm {
     #[getter]
     fn lambda_<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         PyArray1::from_vec(py, self.model.chosen.iter().map(|c| c.lambda).collect())
+    }
+
+    /// The elastic-net path of output `k` (0..5) as arrays: `lambdas` `(L,)`, `coef_path`
+    /// `(L, n_features)` (original features), `intercept_path` `(L,)`, `cv_mse_mean` and
+    /// `cv_mse_se` `(L,)` (standardized targets), and the indices `index_min`, `index_1se`,
+    /// `index_chosen`.
+    fn cv_path<'py>(&self, py: Python<'py>, k: usize) -> PyResult<Bound<'py, PyDict>> {
+        let Some(t) = self.model.fit.targets.get(k) else {
+            return Err(PyValueError::new_err(format!(
+                "output {k}: the model has {} outputs",
+                self.model.fit.targets.len()
+            )));
+        };
+        let d = PyDict::new(py);
+        let n = t.lambdas.len();
+        let p = self.model.n_features();
+        let flat: Vec<f64> = t.coef_path.iter().flatten().copied().collect();
+        d.set_item("name", &t.name)?;
+        d.set_item("lambdas", PyArray1::from_slice(py, &t.lambdas))?;
+        d.set_item("coef_path", PyArray1::from_vec(py, flat).reshape([n, p])?)?;
+        d.set_item(
+            "intercept_path",
+            PyArray1::from_slice(py, &t.intercept_path),
+        )?;
+        d.set_item("cv_mse_mean", PyArray1::from_slice(py, &t.cv_mse_mean))?;
+        d.set_item("cv_mse_se", PyArray1::from_slice(py, &t.cv_mse_se))?;
+        d.set_item("index_min", t.index_min)?;
+        d.set_item("index_1se", t.index_1se)?;
+        d.set_item("index_chosen", t.index_chosen)?;
+        Ok(d)
     }
 
     /// The model file's JSON text (options, the cross-validation path of every output).

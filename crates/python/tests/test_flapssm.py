@@ -1,5 +1,6 @@
 """The Python package against the CLI, the files and itself."""
 
+import json
 import os
 import signal
 
@@ -7,6 +8,7 @@ import numpy as np
 import pytest
 
 import flapssm
+from conftest import SHARED
 
 
 @pytest.fixture(scope="module")
@@ -146,3 +148,46 @@ def test_evaluate_returns_the_metrics(small, tmp_path):
     assert names == ["PR-SSM", "LRQSM"]
     assert (tmp_path / "eval" / "metrics.json").exists()
     assert report["authority_findings"] is not None
+
+
+def test_trajectories_kinematics_and_sysid_equal_the_cli(cli, tmp_path):
+    ds = flapssm.trajectories(3, seed=4)
+    assert ds.outputs is None
+    cli("trajectories", "--n", 3, "--seed", 4, "--out", tmp_path / "t.npz")
+    from_cli = flapssm.Dataset.load(tmp_path / "t.npz")
+    assert np.array_equal(from_cli.inputs, ds.inputs) and np.array_equal(from_cli.euler_rad, ds.euler_rad)
+
+    # The generator's inputs are analytic: the differentiated angles give them back.
+    u = flapssm.kinematics(ds.euler_rad[0], ds.dt_s)
+    assert u.shape == (470, 7)
+    scale = np.abs(ds.inputs[0]).max(axis=0)
+    interior = slice(10, -10)
+    err = np.abs(u[interior] - ds.inputs[0][interior]).max(axis=0) / scale
+    assert (err < 0.02).all(), err
+    with pytest.raises(ValueError, match="shape"):
+        flapssm.kinematics(ds.euler_rad[0][:, :2], ds.dt_s)
+
+    ballbeam = SHARED / "data" / "sysid" / "ballbeam.csv"
+    args = dict(split=0.5, seeds=1, restarts=1, iterations=5)
+    seen = []
+    report = flapssm.sysid(ballbeam, ["u"], ["y"], progress=lambda s, r: seen.append((s, r)), **args)
+    out = cli("sysid", ballbeam, "--input", "u", "--output", "y", "--seeds", 1, "--restarts", 1,
+              "--iterations", 5, "--json").stdout
+    from_cli = json.loads(out)
+    assert report["rmse"] == from_cli["rmse"] and report["nll"] == from_cli["nll"]
+    assert seen == [(0, report["runs"][0]["test"]["rmse"])]
+    with pytest.raises(FileNotFoundError):
+        flapssm.sysid(tmp_path / "missing.csv", ["u"], ["y"], **args)
+    with pytest.raises(ValueError, match="combine"):
+        flapssm.sysid(ballbeam, ["u"], ["y"], combine="vote", **args)
+
+
+def test_lrqsm_cv_path_as_arrays(small):
+    m = flapssm.LRQSM.fit(small, n_folds=3)
+    path = m.cv_path(1)
+    n = path["lambdas"].shape[0]
+    assert path["coef_path"].shape == (n, 11) and path["cv_mse_mean"].shape == (n,)
+    assert np.array_equal(path["coef_path"][path["index_chosen"]], m.coef_[1])
+    assert path["lambdas"][path["index_chosen"]] == m.lambda_[1]
+    with pytest.raises(ValueError, match="5 outputs"):
+        m.cv_path(5)

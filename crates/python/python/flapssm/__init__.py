@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import json
 import os
-from typing import Any, Callable, Optional, Union
+from typing import Any, Callable, Optional, Sequence, Union
 
 import numpy as np
 
@@ -36,6 +36,9 @@ __all__ = [
     "PRSSM",
     "Stream",
     "simulate",
+    "trajectories",
+    "kinematics",
+    "sysid",
     "train",
     "evaluate",
     "LRQSMRegressor",
@@ -83,6 +86,43 @@ def simulate(
     the same seed gives the same dataset as the CLI. ``fidelity``: ``l0`` quasi-steady,
     ``l1`` unsteady low-order, ``l2`` vortex method. ``progress(stage, position, total)``."""
     return _native.simulate(int(n), int(seed), fidelity, n_train, noise_free, flat, progress)
+
+
+def trajectories(n: int = 548, seed: int = 0, n_train: Optional[int] = None) -> "_native.Dataset":
+    """Random wing trajectories (``flapssm trajectories``): a kinematics-only dataset
+    (``outputs`` is None), identical to the CLI's for the same seed."""
+    return _native.trajectories(int(n), int(seed), n_train)
+
+
+def kinematics(euler_rad: Any, dt_s: float, half_window: Optional[int] = None,
+               order: Optional[int] = None) -> np.ndarray:
+    """The wing-frame inputs ``(T, 7)`` of measured Euler angles ``(T, 3)`` [φ, ψ, α] (rad)
+    sampled every ``dt_s`` (s): Savitzky–Golay derivatives (window ``2·half_window + 1``
+    samples, default spanning 0.48 s; degree ``order``, default 6), then the kinematics at
+    unit span distance. Samples within a half window of either end are extrapolated by the
+    edge polynomials."""
+    e = as_float_array("euler_rad", euler_rad, (None, 3))
+    return _native.kinematics(e, float(dt_s), half_window, order)
+
+
+def sysid(
+    path: PathLike,
+    inputs: Sequence[Union[str, int]],
+    outputs: Sequence[Union[str, int]],
+    split: float = 0.5,
+    seeds: int = 3,
+    restarts: int = 2,
+    combine: str = "ensemble",
+    iterations: int = 3000,
+    lr: float = 0.1,
+    progress: Optional[Callable[[int, float], Any]] = None,
+) -> dict:
+    """The system-identification protocol on a recorded file (CSV, whitespace table or MAT;
+    ``flapssm sysid --json``): columns by name or 0-based index; returns the report as a dict
+    (test RMSE and NLL over seeds, per-seed runs). ``progress(seed, test_rmse)``."""
+    text = _native.sysid(os.fspath(path), list(inputs), list(outputs), float(split), int(seeds),
+                         int(restarts), combine, int(iterations), float(lr), progress)
+    return json.loads(text)
 
 
 def train(
