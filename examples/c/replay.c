@@ -3,12 +3,14 @@
  * the model and the stream are created once, then each input sample is stepped with no
  * allocation.
  *
- *   replay MODEL.json INPUTS.csv [--particles P] [--seed S] [--f32] [--repeat R]
+ *   replay MODEL.json INPUTS.csv [--particles P] [--seed S] [--f32 | --f32-native] [--repeat R]
  *
  * INPUTS.csv: a header line, then one row of D_u numbers per time step, in the model's input
  * order and units (the wing: AoA rad, |v| m/s, a_x a_y a_z m/s^2, pitch rate rad/s, pitch
  * acceleration rad/s^2). Writes `step,mean_0..,var_0..` rows to stdout (%.17g), like
  * `flapssm predict --inputs`, and the time per step and the stream's size to stderr.
+ * --f32: float inputs and outputs on the double-precision stream (flapssm_stream_step_f32);
+ * --f32-native: the single-precision stream (flapssm_stream_f32_*).
  * --repeat R replays the trajectory R times (reset between replays) for a steadier timing;
  * only the first replay is printed.
  *
@@ -83,18 +85,19 @@ static double seconds(void) {
 
 int main(int argc, char **argv) {
     if (argc < 3) {
-        fprintf(stderr, "usage: replay MODEL.json INPUTS.csv [--particles P] [--seed S] [--f32] [--repeat R]\n");
+        fprintf(stderr, "usage: replay MODEL.json INPUTS.csv [--particles P] [--seed S] [--f32 | --f32-native] [--repeat R]\n");
         return 2;
     }
     size_t particles = 30;
     unsigned long long seed = 0;
-    int single = 0;
+    int single = 0; /* 1: float I/O on the double stream; 2: the single-precision stream */
     long repeat = 1;
     for (int i = 3; i < argc; i++) {
         if (!strcmp(argv[i], "--particles") && i + 1 < argc) particles = strtoul(argv[++i], NULL, 10);
         else if (!strcmp(argv[i], "--seed") && i + 1 < argc) seed = strtoull(argv[++i], NULL, 10);
         else if (!strcmp(argv[i], "--repeat") && i + 1 < argc) repeat = strtol(argv[++i], NULL, 10);
         else if (!strcmp(argv[i], "--f32")) single = 1;
+        else if (!strcmp(argv[i], "--f32-native")) single = 2;
         else {
             fprintf(stderr, "replay: unknown argument %s\n", argv[i]);
             return 2;
@@ -103,14 +106,19 @@ int main(int argc, char **argv) {
 
     FlapssmModel *model = NULL;
     FlapssmStream *stream = NULL;
+    FlapssmStreamF32 *stream32 = NULL;
     if (flapssm_model_load(argv[1], &model) != FLAPSSM_STATUS_OK) return fail("loading the model");
     size_t du = flapssm_model_n_input(model), dy = flapssm_model_n_output(model);
     if (du > MAX_COLUMNS || dy > MAX_COLUMNS) {
         fprintf(stderr, "replay: model too wide\n");
         return 1;
     }
-    if (flapssm_stream_new(model, particles, seed, &stream) != FLAPSSM_STATUS_OK)
+    if (single == 2) {
+        if (flapssm_stream_f32_new(model, particles, seed, &stream32) != FLAPSSM_STATUS_OK)
+            return fail("creating the stream");
+    } else if (flapssm_stream_new(model, particles, seed, &stream) != FLAPSSM_STATUS_OK) {
         return fail("creating the stream");
+    }
     flapssm_model_free(model);
 
     size_t rows = 0;
@@ -126,13 +134,17 @@ int main(int argc, char **argv) {
 
     double t0 = seconds();
     for (long r = 0; r < repeat; r++) {
-        if (r > 0 && flapssm_stream_reset(stream) != FLAPSSM_STATUS_OK) return fail("reset");
+        if (r > 0) {
+            FlapssmStatus reset = single == 2 ? flapssm_stream_f32_reset(stream32) : flapssm_stream_reset(stream);
+            if (reset != FLAPSSM_STATUS_OK) return fail("reset");
+        }
         for (size_t t = 0; t < rows; t++) {
             const double *ut = u + t * du;
             FlapssmStatus status;
             if (single) {
                 for (size_t j = 0; j < du; j++) u32[j] = (float)ut[j];
-                status = flapssm_stream_step_f32(stream, u32, du, mean32, var32, dy);
+                status = single == 2 ? flapssm_stream_f32_step(stream32, u32, du, mean32, var32, dy)
+                                     : flapssm_stream_step_f32(stream, u32, du, mean32, var32, dy);
                 for (size_t d = 0; d < dy; d++) {
                     mean[d] = mean32[d];
                     var[d] = var32[d];
@@ -150,9 +162,10 @@ int main(int argc, char **argv) {
     }
     double per_step = (seconds() - t0) / ((double)rows * (double)repeat);
     fprintf(stderr, "replay: %zu steps x %ld, %zu particles, %s: %.2f us per step (printing included in the first replay)\n",
-            rows, repeat, particles, single ? "f32" : "f64", 1e6 * per_step);
+            rows, repeat, particles, single == 2 ? "f32 native" : single ? "f32 I/O" : "f64", 1e6 * per_step);
 
     flapssm_stream_free(stream);
+    flapssm_stream_f32_free(stream32);
     free(u);
     return 0;
 }

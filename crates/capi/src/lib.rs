@@ -28,9 +28,11 @@
 //!   `FLAPSSM_STATUS_PANIC`).
 //! - Creation allocates; [`flapssm_stream_step`], [`flapssm_stream_step_f32`] and
 //!   [`flapssm_stream_reset`] allocate nothing.
-//! - The `float` step converts at the boundary: the particles and the model stay in double
-//!   precision, so its outputs are the double step's rounded to `float` (relative error
-//!   ≤ 2⁻²⁴ on top of the inputs' own rounding).
+//! - Two single-precision paths: [`flapssm_stream_step_f32`] converts at the boundary of a
+//!   double-precision stream (its outputs are the double step's rounded to `float`), and
+//!   [`FlapssmStreamF32`] (`flapssm_stream_f32_*`) runs the particles, the kernel and the
+//!   products in `float` (half the memory; for FPUs without fast double precision), with the
+//!   same draws.
 //!
 //! A handle is used by one thread at a time; distinct streams of one model may run on
 //! distinct threads (the model is read only).
@@ -40,6 +42,7 @@
 mod model;
 mod status;
 mod stream;
+mod stream_f32;
 
 pub use model::{
     FlapssmModel, flapssm_model_free, flapssm_model_load, flapssm_model_n_input,
@@ -49,4 +52,8 @@ pub use status::{FlapssmStatus, flapssm_last_error};
 pub use stream::{
     FlapssmStream, flapssm_stream_free, flapssm_stream_new, flapssm_stream_reset,
     flapssm_stream_step, flapssm_stream_step_f32,
+};
+pub use stream_f32::{
+    FlapssmStreamF32, flapssm_stream_f32_free, flapssm_stream_f32_new, flapssm_stream_f32_reset,
+    flapssm_stream_f32_step,
 };

@@ -15,6 +15,18 @@ pub struct FlapssmStream {
     u: Vec<f64>,
 }
 
+/// The input and output counts of a stream handle.
+pub(crate) trait Dims {
+    /// `(D_u, D_y)`.
+    fn dims(&self) -> (usize, usize);
+}
+
+impl Dims for FlapssmStream {
+    fn dims(&self) -> (usize, usize) {
+        (self.stream.n_input(), self.stream.n_output())
+    }
+}
+
 /// Creates a streaming predictor of `model` with `particles` particles (the paper: 30) and
 /// the draws of `seed`, started from `x₀ = 0`, and stores it in `*out` (to be freed with
 /// [`flapssm_stream_free`]). The stream does not borrow the model: the model may be freed.
@@ -65,14 +77,14 @@ pub unsafe extern "C" fn flapssm_stream_new(
 ///
 /// # Safety
 /// As [`flapssm_stream_step`].
-unsafe fn with_arrays<T>(
-    stream: *mut FlapssmStream,
+pub(crate) unsafe fn with_arrays<H: Dims, T>(
+    stream: *mut H,
     u: *const T,
     n_input: usize,
     mean: *mut T,
     var: *mut T,
     n_output: usize,
-    body: impl FnOnce(&mut FlapssmStream, &[T], &mut [T], &mut [T]) -> FlapssmStatus,
+    body: impl FnOnce(&mut H, &[T], &mut [T], &mut [T]) -> FlapssmStatus,
 ) -> FlapssmStatus {
     guard(|| {
         // SAFETY: null or live, by the caller's contract.
@@ -85,7 +97,7 @@ unsafe fn with_arrays<T>(
                 "step: null input or output array",
             );
         }
-        let (du, dy) = (s.stream.n_input(), s.stream.n_output());
+        let (du, dy) = s.dims();
         if n_input != du || n_output != dy {
             return fail(
                 FlapssmStatus::Shape,

@@ -145,6 +145,30 @@ fn errors_are_statuses_with_messages() {
         unsafe { flapssm_stream_reset(null_mut()) },
         FlapssmStatus::NullArgument
     );
+    let mut stream32 = null_mut();
+    assert_eq!(
+        unsafe { flapssm_stream_f32_new(null(), 30, 0, &mut stream32) },
+        FlapssmStatus::NullArgument
+    );
+    let u32 = [0.1f32; 7];
+    let (mut m32, mut v32) = ([0.0f32; 5], [0.0f32; 5]);
+    assert_eq!(
+        unsafe {
+            flapssm_stream_f32_step(
+                null_mut(),
+                u32.as_ptr(),
+                7,
+                m32.as_mut_ptr(),
+                v32.as_mut_ptr(),
+                5,
+            )
+        },
+        FlapssmStatus::NullArgument
+    );
+    assert_eq!(
+        unsafe { flapssm_stream_f32_reset(null_mut()) },
+        FlapssmStatus::NullArgument
+    );
     unsafe {
         flapssm_stream_free(stream);
         flapssm_stream_free(null_mut());
@@ -170,6 +194,13 @@ fn stepping_allocates_nothing_and_the_footprint_is_measured() {
             FlapssmStatus::Ok
         );
         let footprint = LIVE.load(Ordering::SeqCst) - live;
+        let live = LIVE.load(Ordering::SeqCst);
+        let mut stream32 = null_mut();
+        assert_eq!(
+            unsafe { flapssm_stream_f32_new(model, particles, 0, &mut stream32) },
+            FlapssmStatus::Ok
+        );
+        let footprint32 = LIVE.load(Ordering::SeqCst) - live;
         let (mut mean, mut var) = ([0.0; 5], [0.0; 5]);
         let (mut mean32, mut var32) = ([0.0f32; 5], [0.0f32; 5]);
         let u32: Vec<f32> = u.iter().map(|&v| v as f32).collect();
@@ -194,7 +225,17 @@ fn stepping_allocates_nothing_and_the_footprint_is_measured() {
                     5,
                 );
                 assert_eq!(s, FlapssmStatus::Ok);
+                let s = flapssm_stream_f32_step(
+                    stream32,
+                    ut32.as_ptr(),
+                    DU,
+                    mean32.as_mut_ptr(),
+                    var32.as_mut_ptr(),
+                    5,
+                );
+                assert_eq!(s, FlapssmStatus::Ok);
                 assert_eq!(flapssm_stream_reset(stream), FlapssmStatus::Ok);
+                assert_eq!(flapssm_stream_f32_reset(stream32), FlapssmStatus::Ok);
             }
         }
         assert_eq!(
@@ -202,7 +243,10 @@ fn stepping_allocates_nothing_and_the_footprint_is_measured() {
             0,
             "allocations while stepping"
         );
-        unsafe { flapssm_stream_free(stream) };
+        unsafe {
+            flapssm_stream_free(stream);
+            flapssm_stream_f32_free(stream32);
+        }
         let first = if footprint > 32 << 20 {
             " (the first on this thread: with the GEMM buffer)"
         } else {
@@ -210,7 +254,7 @@ fn stepping_allocates_nothing_and_the_footprint_is_measured() {
         };
         println!(
             "stream of the paper's model (D_x 12, M 100), {particles} particles: \
-             {footprint} bytes allocated{first}"
+             {footprint} bytes allocated{first}; single-precision stream {footprint32} bytes"
         );
     }
     unsafe { flapssm_model_free(model) };

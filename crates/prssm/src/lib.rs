@@ -39,6 +39,7 @@ pub mod params;
 pub mod predict;
 pub mod published;
 pub mod stream;
+pub mod stream_f32;
 pub mod systems;
 mod tape;
 pub mod train;

@@ -294,13 +294,14 @@ pub fn predict(
     predict_with_draws(config, params, inputs, init_mean, init_std, &init, &eps)
 }
 
-struct StepDraws {
-    dx: usize,
-    shared: bool,
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct StepDraws {
+    pub(crate) dx: usize,
+    pub(crate) shared: bool,
 }
 
 impl StepDraws {
-    fn fill(&self, rng: &mut impl Rng, eps: &mut [f64]) {
+    pub(crate) fn fill(&self, rng: &mut impl Rng, eps: &mut [f64]) {
         for e in eps.chunks_exact_mut(self.dx) {
             if self.shared {
                 let v: f64 = StandardNormal.sample(rng);
