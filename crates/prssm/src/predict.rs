@@ -265,8 +265,9 @@ pub fn predict_with_draws(
 
 /// Open-loop prediction with `particles` particles from `N(init_mean, diag init_std²)` under
 /// `inputs` (row-major `T × D_u`, standardized as in training); draws from
-/// `ChaCha8Rng::seed_from_u64(seed)` (initial draws first, then step by step).
-/// Cost `O(T · P · (M D + M²))`.
+/// `ChaCha8Rng::seed_from_u64(seed)` (initial draws first, then step by step, as
+/// [`predict_with_draws`] takes them). Cost `O(T · P · (M D + M²))`; memory `O(P · D_x)`
+/// besides the result: the particles and the draws of one step at a time.
 ///
 /// # Errors
 /// As [`simulate_with_draws`].
@@ -279,19 +280,38 @@ pub fn predict(
     particles: usize,
     seed: u64,
 ) -> Result<Prediction, ObjectiveError> {
-    let (dx, du) = (config.n_state, config.n_input.max(1));
-    let t_n = (inputs.len() / du).max(1);
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let init: Vec<f64> = (0..particles * dx)
-        .map(|_| StandardNormal.sample(&mut rng))
-        .collect();
-    let mut eps = vec![0.0; t_n.saturating_sub(1) * particles * dx];
-    StepDraws {
-        dx,
-        shared: config.shared_draws,
+    let (dx, du, dy) = (config.n_state, config.n_input, config.n_output);
+    if du == 0 && !inputs.is_empty() || du > 0 && (inputs.is_empty() || inputs.len() % du != 0) {
+        return Err(ObjectiveError::Shape(format!(
+            "{} input values are not a T × {du} array",
+            inputs.len()
+        )));
     }
-    .fill(&mut rng, &mut eps);
-    predict_with_draws(config, params, inputs, init_mean, init_std, &init, &eps)
+    if init_mean.len() != dx || init_std.len() != dx {
+        return Err(ObjectiveError::Shape(format!(
+            "initial state must have {dx} means and {dx} stds"
+        )));
+    }
+    let t_n = inputs.len().checked_div(du).unwrap_or(1);
+    let mut sp = StepPredictor::new(config, params, particles)?;
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut x = vec![0.0; particles * dx];
+    for c in x.chunks_exact_mut(dx) {
+        for d in 0..dx {
+            let e: f64 = StandardNormal.sample(&mut rng);
+            c[d] = init_mean[d] + init_std[d] * e;
+        }
+    }
+    let (vx, vy) = (&params.process_noise_var, &params.obs_noise_var);
+    let mut pred = empty_prediction(t_n, dx, dy);
+    moments(&x, dx, dy, vx, vy, &mut pred, 0);
+    let mut eps = vec![0.0; particles * dx];
+    for t in 0..t_n - 1 {
+        sp.draw(&mut rng, &mut eps);
+        sp.step(&mut x, &inputs[t * du..(t + 1) * du], &eps);
+        moments(&x, dx, dy, vx, vy, &mut pred, t + 1);
+    }
+    Ok(pred)
 }
 
 #[derive(Debug, Clone, Copy)]
