@@ -118,6 +118,25 @@ def test_keyboard_interrupt_leaves_a_resumable_checkpoint(small, tmp_path):
     assert len(calls) > 3
 
 
+def test_ctrl_c_from_outside_stops_training_with_a_checkpoint(small, tmp_path):
+    # SIGINT from another thread while the main thread is inside the Rust training loop
+    # (no callback): the loop's own check of Python's signals stops it.
+    import threading
+
+    out = tmp_path / "m.json"
+    timer = threading.Timer(0.3, lambda: os.kill(os.getpid(), signal.SIGINT))
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt, match="resume"):
+            flapssm.train(small, out, "sysid", dx=5, inducing=8, particles=4, batch=2,
+                          epochs=100_000, checkpoint_every=0, seed=2)
+    finally:
+        timer.cancel()
+    checkpoint = json.loads((tmp_path / "m.ckpt.json").read_text())
+    assert checkpoint["state"]["step"] > 0
+    assert not [f for f in os.listdir(tmp_path) if f.endswith(".tmp")]
+
+
 def test_estimators_follow_scikit_learn_conventions(small):
     est = flapssm.LRQSMRegressor(n_folds=3)
     assert est.get_params()["n_folds"] == 3
