@@ -50,7 +50,7 @@ print(model)
 # 4. Predict the first test trajectory, as a batch and as a stream (the same numbers).
 test = ds.n_train
 u = ds.inputs[test]
-mean, var, _ = model.predict_inputs(u, particles=30, seed=0)
+mean, var, _, _ = model.predict_inputs(u, particles=30, seed=0)
 stream = model.stream(particles=30, seed=0)
 streamed = np.array([stream.step(u_t)[0] for u_t in u])
 assert np.array_equal(streamed, mean)

@@ -160,6 +160,8 @@ pub fn predict_dataset_file(
 pub struct InputsPrediction {
     /// Output and latent moments (outputs in the model's units).
     pub prediction: Prediction,
+    /// Every particle, `T × P × D_x` row-major (standardized latent units), when asked for.
+    pub particles: Option<Vec<f64>>,
     /// Notes (e.g. an initial-state rule that the inputs alone cannot apply).
     pub notes: Vec<String>,
 }
@@ -236,6 +238,22 @@ pub fn predict_inputs(
     particles: usize,
     seed: u64,
 ) -> Result<InputsPrediction> {
+    predict_inputs_kept(model, inputs, n_columns, particles, seed, false)
+}
+
+/// [`predict_inputs`] that, with `keep_particles`, also returns every particle
+/// ([`InputsPrediction::particles`]); the moments are the same.
+///
+/// # Errors
+/// As [`predict_inputs`]; a particle history larger than memory is refused up front.
+pub fn predict_inputs_kept(
+    model: &PrssmModel,
+    inputs: &[f64],
+    n_columns: usize,
+    particles: usize,
+    seed: u64,
+    keep_particles: bool,
+) -> Result<InputsPrediction> {
     let du = model.config.n_input;
     if n_columns != du {
         return Err(JobError::Mismatch {
@@ -244,15 +262,24 @@ pub fn predict_inputs(
             found: format!("{n_columns} columns"),
         });
     }
-    crate::resources::check_prediction(&model.config, particles, 1, 0.0)?;
+    let kept = if keep_particles {
+        (inputs.len() / du.max(1)) as f64 * (particles * model.config.n_state * 8) as f64
+    } else {
+        0.0
+    };
+    crate::resources::check_prediction(&model.config, particles, 1, kept)?;
     let notes = inputs_only_notes(model);
-    let prediction = model
-        .predict_inputs(inputs, particles, prediction_seed(seed, 0))
+    let (prediction, particles) = model
+        .predict_inputs_kept(inputs, particles, prediction_seed(seed, 0), keep_particles)
         .map_err(|e| JobError::Prssm {
             what: "prediction".into(),
             source: e.into(),
         })?;
-    Ok(InputsPrediction { prediction, notes })
+    Ok(InputsPrediction {
+        prediction,
+        particles,
+        notes,
+    })
 }
 
 #[cfg(test)]

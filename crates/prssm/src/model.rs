@@ -101,47 +101,61 @@ impl PrssmModel {
         particles: usize,
         seed: u64,
     ) -> Result<Prediction, ObjectiveError> {
+        Ok(self.predict_inputs_kept(inputs, particles, seed, false)?.0)
+    }
+
+    /// [`Self::predict_inputs`] that also returns every particle when `keep_particles`
+    /// (`T × P × D_x` row-major, standardized latent units; the moments are unchanged).
+    ///
+    /// # Errors
+    /// As [`Self::predict_inputs`].
+    pub fn predict_inputs_kept(
+        &self,
+        inputs: &[f64],
+        particles: usize,
+        seed: u64,
+        keep_particles: bool,
+    ) -> Result<(Prediction, Option<Vec<f64>>), ObjectiveError> {
         let (dx, du, dy) = (
             self.config.n_state,
             self.config.n_input,
             self.config.n_output,
         );
         let zero = vec![0.0; dx];
-        let Some(n) = &self.normalization else {
-            return predict::predict(
-                &self.config,
-                &self.params,
-                inputs,
-                &zero,
-                &zero,
-                particles,
-                seed,
-            );
+        let standardized: Vec<f64>;
+        let z = match &self.normalization {
+            Some(n) => {
+                standardized = inputs
+                    .iter()
+                    .enumerate()
+                    .map(|(i, v)| (v - n.input_mean[i % du]) / n.input_std[i % du])
+                    .collect();
+                &standardized[..]
+            }
+            None => inputs,
         };
-        let z: Vec<f64> = inputs
-            .iter()
-            .enumerate()
-            .map(|(i, v)| (v - n.input_mean[i % du]) / n.input_std[i % du])
-            .collect();
-        let mut p = predict::predict(
-            &self.config,
-            &self.params,
-            &z,
-            &zero,
-            &zero,
-            particles,
-            seed,
-        )?;
-        for (i, (m, v)) in p
-            .output_mean
-            .iter_mut()
-            .zip(p.output_var.iter_mut())
-            .enumerate()
-        {
-            let s = n.output_std[i % dy];
-            *m = *m * s + n.output_mean[i % dy];
-            *v *= s * s;
+        let (c, p) = (&self.config, &self.params);
+        let (mut pred, all) = if keep_particles {
+            let (pred, all) = predict::predict_particles(c, p, z, (&zero, &zero), particles, seed)?;
+            (pred, Some(all))
+        } else {
+            (
+                predict::predict(c, p, z, &zero, &zero, particles, seed)?,
+                None,
+            )
+        };
+        if let Some(n) = &self.normalization {
+            for (i, (m, v)) in pred
+                .output_mean
+                .iter_mut()
+                .zip(pred.output_var.iter_mut())
+                .enumerate()
+            {
+                let s = n.output_std[i % dy];
+                *m = *m * s + n.output_mean[i % dy];
+                *v *= s * s;
+            }
         }
-        Ok(p)
+        Ok((pred, all))
     }
 }

@@ -280,6 +280,49 @@ pub fn predict(
     particles: usize,
     seed: u64,
 ) -> Result<Prediction, ObjectiveError> {
+    let init = (init_mean, init_std);
+    run_prediction(config, params, inputs, init, particles, seed, None)
+}
+
+/// [`predict`] that also returns every particle, `T × P × D_x` row-major (standardized latent
+/// units): the same draws, so the moments are [`predict`]'s exactly.
+///
+/// # Errors
+/// As [`predict`].
+pub fn predict_particles(
+    config: &ModelConfig,
+    params: &Params,
+    inputs: &[f64],
+    (init_mean, init_std): (&[f64], &[f64]),
+    particles: usize,
+    seed: u64,
+) -> Result<(Prediction, Vec<f64>), ObjectiveError> {
+    let t_n = inputs.len().checked_div(config.n_input).unwrap_or(1).max(1);
+    let mut all = vec![0.0; t_n * particles * config.n_state];
+    let init = (init_mean, init_std);
+    let p = run_prediction(
+        config,
+        params,
+        inputs,
+        init,
+        particles,
+        seed,
+        Some(&mut all),
+    )?;
+    Ok((p, all))
+}
+
+/// The prediction loop of [`predict`], copying the particles of every step into `keep`
+/// (`T × P × D_x`) when given.
+fn run_prediction(
+    config: &ModelConfig,
+    params: &Params,
+    inputs: &[f64],
+    (init_mean, init_std): (&[f64], &[f64]),
+    particles: usize,
+    seed: u64,
+    mut keep: Option<&mut [f64]>,
+) -> Result<Prediction, ObjectiveError> {
     let (dx, du, dy) = (config.n_state, config.n_input, config.n_output);
     if du == 0 && !inputs.is_empty() || du > 0 && (inputs.is_empty() || inputs.len() % du != 0) {
         return Err(ObjectiveError::Shape(format!(
@@ -304,12 +347,19 @@ pub fn predict(
     }
     let (vx, vy) = (&params.process_noise_var, &params.obs_noise_var);
     let mut pred = empty_prediction(t_n, dx, dy);
+    let mut record = |t: usize, x: &[f64]| {
+        if let Some(k) = keep.as_deref_mut() {
+            k[t * x.len()..(t + 1) * x.len()].copy_from_slice(x);
+        }
+    };
     moments(&x, dx, dy, vx, vy, &mut pred, 0);
+    record(0, &x);
     let mut eps = vec![0.0; particles * dx];
     for t in 0..t_n - 1 {
         sp.draw(&mut rng, &mut eps);
         sp.step(&mut x, &inputs[t * du..(t + 1) * du], &eps);
         moments(&x, dx, dy, vx, vy, &mut pred, t + 1);
+        record(t + 1, &x);
     }
     Ok(pred)
 }

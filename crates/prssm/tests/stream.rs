@@ -241,3 +241,24 @@ fn a_single_precision_step_does_not_allocate() {
     assert!(acc.is_finite());
     assert_eq!(allocations() - before, 0, "allocations during 49 f32 steps");
 }
+
+/// Keeping the particles changes nothing in the moments, and the kept particles are the ones
+/// the moments are taken of.
+#[test]
+fn kept_particles_give_the_same_prediction() {
+    let m = model(4, 2, 2, 10, false);
+    let u = inputs(40, 2);
+    let zero = [0.0; 4];
+    let plain = predict::predict(&m.config, &m.params, &u, &zero, &zero, 7, 3).unwrap();
+    let (kept, all) =
+        predict::predict_particles(&m.config, &m.params, &u, (&zero, &zero), 7, 3).unwrap();
+    assert_eq!(plain.output_mean, kept.output_mean);
+    assert_eq!(plain.latent_var, kept.latent_var);
+    assert_eq!(all.len(), 40 * 7 * 4);
+    for t in 0..40 {
+        for d in 0..4 {
+            let mean = (0..7).map(|c| all[(t * 7 + c) * 4 + d]).sum::<f64>() / 7.0;
+            assert!((mean - plain.latent_mean[t * 4 + d]).abs() < 1e-12);
+        }
+    }
+}

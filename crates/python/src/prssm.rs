@@ -19,6 +19,13 @@ use crate::progress::PyProgress;
 
 /// Arrays of a prediction: output mean, output variance, latent mean.
 type Moments<'py, A> = PyResult<(Bound<'py, A>, Bound<'py, A>, Bound<'py, A>)>;
+/// [`Prssm::predict_inputs`]' arrays: output mean and variance, latent mean, particles.
+type InputsMoments<'py> = (
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray2<f64>>,
+    Option<Bound<'py, PyArray3<f64>>>,
+);
 /// A step's output mean and variance.
 type StepMoments<'py> = PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>)>;
 
@@ -81,26 +88,41 @@ impl Prssm {
 
     /// Open-loop prediction from inputs `(T, D_u)` (`flapssm predict --inputs`): from
     /// `x₀ = 0`, draws of `prediction_seed(seed, 0)`. Returns output mean and variance
-    /// `(T, D_y)` and latent mean `(T, D_x)` (standardized units).
-    #[pyo3(signature = (inputs, particles=30, seed=0))]
+    /// `(T, D_y)`, latent mean `(T, D_x)` (standardized units) and, with `return_particles`,
+    /// every particle `(T, P, D_x)` (standardized units; else `None`).
+    #[pyo3(signature = (inputs, particles=30, seed=0, return_particles=false))]
     fn predict_inputs<'py>(
         &self,
         py: Python<'py>,
         inputs: PyReadonlyArray2<'py, f64>,
         particles: usize,
         seed: u64,
-    ) -> Moments<'py, PyArray2<f64>> {
+        return_particles: bool,
+    ) -> PyResult<InputsMoments<'py>> {
         let (t, du) = (inputs.shape()[0], inputs.shape()[1]);
         let u = inputs.as_slice()?.to_vec();
-        let p = py
-            .detach(|| flapssm_jobs::predict::predict_inputs(&self.model, &u, du, particles, seed))
-            .map_err(|e| job_error(e, None))?
-            .prediction;
+        let out = py
+            .detach(|| {
+                flapssm_jobs::predict::predict_inputs_kept(
+                    &self.model,
+                    &u,
+                    du,
+                    particles,
+                    seed,
+                    return_particles,
+                )
+            })
+            .map_err(|e| job_error(e, None))?;
+        let (p, kept) = (out.prediction, out.particles);
         let (dy, dx) = (self.model.config.n_output, self.model.config.n_state);
+        let kept = kept
+            .map(|k| PyArray1::from_vec(py, k).reshape([t, particles, dx]))
+            .transpose()?;
         Ok((
             PyArray1::from_vec(py, p.output_mean).reshape([t, dy])?,
             PyArray1::from_vec(py, p.output_var).reshape([t, dy])?,
             PyArray1::from_vec(py, p.latent_mean).reshape([t, dx])?,
+            kept,
         ))
     }
 

@@ -51,8 +51,12 @@ def test_prediction_equals_the_cli_and_the_stream(cli, published, tmp_path):
     model.save(tmp_path / "m.json")
     cli("predict", tmp_path / "m.json", "--inputs", csv, "--seed", 5, "--out", tmp_path / "p.csv")
     table = np.loadtxt(tmp_path / "p.csv", delimiter=",", skiprows=1)
-    mean, var, latent = model.predict_inputs(u, particles=30, seed=5)
-    assert mean.shape == (470, 5) and latent.shape == (470, 12)
+    mean, var, latent, none = model.predict_inputs(u, particles=30, seed=5)
+    assert mean.shape == (470, 5) and latent.shape == (470, 12) and none is None
+    m2, v2, l2, particles = model.predict_inputs(u, particles=30, seed=5, return_particles=True)
+    assert particles.shape == (470, 30, 12)
+    assert np.array_equal(m2, mean) and np.array_equal(v2, var) and np.array_equal(l2, latent)
+    assert np.allclose(particles.mean(axis=1), latent, rtol=1e-12, atol=1e-12)
     assert np.allclose(table[:, 1:6], mean, rtol=1e-15, atol=0)
     assert np.allclose(table[:, 6:11], var, rtol=1e-15, atol=0)
 
