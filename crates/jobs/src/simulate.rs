@@ -5,7 +5,9 @@ use std::path::Path;
 use flapssm_wing::dataset::ValidDataset;
 use flapssm_wing::sensor::SensorConfig;
 use flapssm_wing::trajectories::{GeneratorConfig, default_n_train};
-use flapssm_wing::virtual_wing::{Fidelity, SimulationConfig, VirtualWingConfig, simulate_dataset};
+use flapssm_wing::virtual_wing::{
+    Fidelity, SimulationConfig, VirtualWingConfig, simulate_angles_dataset, simulate_dataset,
+};
 
 use crate::error::{JobError, Result};
 use crate::progress::Progress;
@@ -106,6 +108,41 @@ pub fn simulate(
             source,
         })?;
     }
+    progress.finish(&format!("{} trajectories", ds.len()));
+    Ok(ds)
+}
+
+/// Simulates the wing of `settings` (fidelity, sensor, seed, split; `n_trajectories` must be
+/// `angles_rad.len()`, `flat` does not apply) on given Euler angles: trajectory `i` is
+/// `angles_rad[i]`, 470 rows [φ, ψ, α] (rad) at 25 Hz, as the paper's measured trajectories
+/// ([`flapssm_wing::virtual_wing::simulate_angles_dataset`]). `progress.advance(1)` per
+/// trajectory.
+///
+/// # Errors
+/// [`JobError::Setting`] for a count that is not the number of trajectories or a bad split;
+/// [`JobError::Simulate`] naming a trajectory of the wrong length.
+pub fn simulate_angles(
+    settings: &SimulateSettings,
+    angles_rad: &[Vec<[f64; 3]>],
+    progress: &dyn Progress,
+) -> Result<ValidDataset> {
+    if settings.n_trajectories != angles_rad.len() {
+        return Err(JobError::Setting {
+            name: "n".into(),
+            value: settings.n_trajectories.to_string(),
+            expected: format!("the {} trajectories given", angles_rad.len()),
+        });
+    }
+    let cfg = settings.check()?;
+    progress.start("simulate", angles_rad.len() as u64);
+    let ds = simulate_angles_dataset(
+        &cfg.wing,
+        angles_rad,
+        &cfg.trajectories.sampling,
+        settings.seed,
+        cfg.trajectories.n_train,
+        &|| progress.advance(1),
+    )?;
     progress.finish(&format!("{} trajectories", ds.len()));
     Ok(ds)
 }

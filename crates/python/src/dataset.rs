@@ -301,3 +301,41 @@ pub fn kinematics<'py>(
     let flat: Vec<f64> = inputs.iter().flatten().copied().collect();
     PyArray1::from_vec(py, flat).reshape([t, 7])
 }
+
+/// Simulates the virtual wing on given Euler angles `(n, 470, 3)` (rad, 25 Hz; the paper's
+/// measured trajectories): the same wing, sensor and split settings as [`simulate`].
+#[pyfunction]
+#[pyo3(signature = (euler_rad, seed, fidelity, n_train=None, noise_free=false, progress=None))]
+pub fn simulate_angles(
+    py: Python<'_>,
+    euler_rad: PyReadonlyArray3<'_, f64>,
+    seed: u64,
+    fidelity: &str,
+    n_train: Option<usize>,
+    noise_free: bool,
+    progress: Option<Py<PyAny>>,
+) -> PyResult<Dataset> {
+    let fidelity: Fidelity = fidelity
+        .parse()
+        .map_err(|e| PyValueError::new_err(format!("fidelity: {e}")))?;
+    let (n, t) = (euler_rad.shape()[0], euler_rad.shape()[1]);
+    let flat = euler_rad.as_slice()?;
+    let angles: Vec<Vec<[f64; 3]>> = (0..n)
+        .map(|i| as_rows(&flat[i * t * 3..(i + 1) * t * 3]))
+        .collect();
+    let settings = SimulateSettings {
+        n_trajectories: n,
+        n_train,
+        seed,
+        fidelity,
+        noise_free,
+        flat: false,
+    };
+    let bar = PyProgress::new(progress);
+    let ds = py.detach(|| flapssm_jobs::simulate::simulate_angles(&settings, &angles, &bar));
+    if let Some(e) = bar.take_error() {
+        return Err(e);
+    }
+    ds.map(|inner| Dataset { inner })
+        .map_err(|e| job_error(e, None))
+}

@@ -214,3 +214,15 @@ def test_lrqsm_cv_path_as_arrays(small):
     assert path["lambdas"][path["index_chosen"]] == m.lambda_[1]
     with pytest.raises(ValueError, match="5 outputs"):
         m.cv_path(5)
+
+
+def test_simulation_on_the_papers_measured_trajectories():
+    euler = np.load(SHARED / "data" / "bayiz2021-kinematics" / "euler_angles.npy")[:3]
+    ds = flapssm.simulate_angles(euler, seed=2, fidelity="l1", n_train=2)
+    assert (len(ds), ds.n_train, ds.n_samples) == (3, 2, 470)
+    assert ds.families == ["measured"] * 3 and np.isfinite(ds.outputs).all()
+    assert np.abs(ds.euler_rad - euler).max() < np.radians(1)
+    again = flapssm.simulate_angles(euler, seed=2, fidelity="l1", n_train=2)
+    assert np.array_equal(again.outputs, ds.outputs)  # same seed, same dataset
+    with pytest.raises(ValueError, match=r"expected \(n, 470, 3\)"):
+        flapssm.simulate_angles(euler[:, :400])

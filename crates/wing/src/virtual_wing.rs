@@ -337,8 +337,23 @@ impl VirtualWing {
         rng: &mut ChaCha8Rng,
     ) -> Result<Trajectory, SimulateError> {
         let states = spec.sample_raw(sampling);
+        let family = spec.family.label();
+        self.simulate_states(&states, family, sampling, index, errors, rng)
+    }
+
+    /// [`Self::simulate`] of given raw-rate states (`n_samples · decimation`, every
+    /// `raw_dt_s`), labelled `family`.
+    pub fn simulate_states(
+        &mut self,
+        states: &[EulerState],
+        family: &str,
+        sampling: &crate::trajectories::SamplingConfig,
+        index: usize,
+        errors: &DatasetSensorErrors,
+        rng: &mut ChaCha8Rng,
+    ) -> Result<Trajectory, SimulateError> {
         let mut raw = vec![[0.0; 5]; states.len()];
-        self.aero_loads_into(&states, sampling.raw_dt_s(), &mut raw);
+        self.aero_loads_into(states, sampling.raw_dt_s(), &mut raw);
         if let Some(sample) = raw.iter().position(|y| y.iter().any(|v| !v.is_finite())) {
             return Err(SimulateError::NonFinite { index, sample });
         }
@@ -374,7 +389,7 @@ impl VirtualWing {
                 .map_err(|source| SimulateError::Differentiate { index, source })?;
             out
         } else {
-            states
+            states.to_vec()
         };
         let decimated: Vec<&EulerState> = measured
             .iter()
@@ -395,7 +410,7 @@ impl VirtualWing {
             inputs,
             outputs: Some(outputs),
             u_ref_m_s,
-            family: spec.family.label().to_string(),
+            family: family.to_string(),
         })
     }
 }
@@ -428,55 +443,130 @@ pub fn simulate_dataset(
     cfg.wing.factory()?;
     let specs = cfg.trajectories.generate()?;
     let sampling = &cfg.trajectories.sampling;
-    let seed = cfg.trajectories.seed ^ SENSOR_SEED_SALT;
-    let mut dataset_rng = ChaCha8Rng::seed_from_u64(seed);
-    dataset_rng.set_stream(u64::MAX);
-    let errors = DatasetSensorErrors::draw(&cfg.wing.sensor, &mut dataset_rng);
-    let run_one = |wing: &mut Result<VirtualWing, SimulateError>,
-                   (index, spec): (usize, &TrajectorySpec)| {
-        let wing = wing.as_mut().map_err(|_| SimulateError::InvalidConfig {
-            field: "wing",
-            value: f64::NAN,
-            reason: "invalid",
-        })?;
-        let mut rng = ChaCha8Rng::seed_from_u64(seed);
-        rng.set_stream(index as u64);
-        let t = wing.simulate(spec, sampling, index, &errors, &mut rng);
-        progress();
-        t
+    let drive = |index: usize| {
+        let spec = &specs[index];
+        Ok((spec.sample_raw(sampling), spec.family.label().to_string()))
     };
-    let trajectories: Result<Vec<Trajectory>, SimulateError> = specs
-        .par_iter()
-        .enumerate()
-        .map_init(|| VirtualWing::new(&cfg.wing), run_one)
-        .collect();
-    let trajectories = trajectories?;
-    let n = trajectories.len().max(1) as f64;
-    let mean_u_ref = trajectories.iter().map(|t| t.u_ref_m_s).sum::<f64>() / n;
-    let reynolds = mean_u_ref * cfg.wing.wing.chord_m / cfg.wing.fluid.kinematic_viscosity_m2_s;
-    let settings = serde_json::json!({
-        "fidelity": cfg.wing.fidelity,
-        "simulation": cfg,
-        "sensor_errors": errors,
-        "mean_u_ref_m_s": mean_u_ref,
-        "mean_reynolds_number": reynolds,
-    });
-    let ds = Dataset {
-        meta: DatasetMeta {
-            format_version: FORMAT_VERSION,
-            wing: cfg.wing.wing.clone(),
-            fluid: cfg.wing.fluid.clone(),
-            generator: "flapssm simulate".to_string(),
-            seed: Some(cfg.trajectories.seed),
-            settings,
-            input_units: INPUT_UNITS.iter().map(|s| s.to_string()).collect(),
-            output_units: OUTPUT_UNITS.iter().map(|s| s.to_string()).collect(),
-        },
-        dt_s: sampling.dataset_dt_s(),
-        trajectories,
+    let run = Run {
+        wing: &cfg.wing,
+        sampling,
+        seed: cfg.trajectories.seed,
         n_train: cfg.trajectories.n_train,
+        generator: "flapssm simulate",
+        settings: serde_json::json!({ "simulation": cfg }),
     };
-    Ok(ValidDataset::new(ds)?)
+    run.simulate(specs.len(), &drive, progress)
+}
+
+/// Simulates the wing of `wing` on given Euler angles: `angles_rad[i]` holds trajectory `i`'s
+/// rows [φ, ψ, α] (rad), `sampling.n_samples` of them every `sampling.dataset_dt_s()` (the
+/// paper's measured trajectories: 470 at 25 Hz), driven at the raw rate by
+/// [`crate::trajectories::measured::raw_states`]. The sensor noise is seeded by `seed`, the
+/// first `n_train` trajectories are the training set, family label `"measured"`, generator
+/// `"flapssm simulate (given angles)"`.
+///
+/// # Errors
+/// A trajectory of the wrong length or too short to differentiate
+/// ([`SimulateError::Differentiate`] naming it), and the errors of [`simulate_dataset`].
+pub fn simulate_angles_dataset(
+    wing: &VirtualWingConfig,
+    angles_rad: &[Vec<[f64; 3]>],
+    sampling: &crate::trajectories::SamplingConfig,
+    seed: u64,
+    n_train: usize,
+    progress: &(dyn Fn() + Sync),
+) -> Result<ValidDataset, SimulateError> {
+    wing.check()?;
+    wing.factory()?;
+    let drive = |index: usize| {
+        crate::trajectories::measured::raw_states(&angles_rad[index], sampling)
+            .map(|states| (states, "measured".to_string()))
+            .map_err(|source| SimulateError::Differentiate { index, source })
+    };
+    let run = Run {
+        wing,
+        sampling,
+        seed,
+        n_train,
+        generator: "flapssm simulate (given angles)",
+        settings: serde_json::json!({ "wing": wing, "sampling": sampling }),
+    };
+    run.simulate(angles_rad.len(), &drive, progress)
+}
+
+/// What a dataset simulation shares, whatever drives the wing.
+struct Run<'a> {
+    wing: &'a VirtualWingConfig,
+    sampling: &'a crate::trajectories::SamplingConfig,
+    seed: u64,
+    n_train: usize,
+    generator: &'static str,
+    /// Settings recorded in the metadata (the fidelity, sensor errors and mean Re are added).
+    settings: serde_json::Value,
+}
+
+impl Run<'_> {
+    /// Runs the wing on the raw states `drive(i)` of trajectories `0..n` in parallel.
+    fn simulate(
+        self,
+        n: usize,
+        drive: &(dyn Fn(usize) -> Result<(Vec<EulerState>, String), SimulateError> + Sync),
+        progress: &(dyn Fn() + Sync),
+    ) -> Result<ValidDataset, SimulateError> {
+        let seed = self.seed ^ SENSOR_SEED_SALT;
+        let mut dataset_rng = ChaCha8Rng::seed_from_u64(seed);
+        dataset_rng.set_stream(u64::MAX);
+        let errors = DatasetSensorErrors::draw(&self.wing.sensor, &mut dataset_rng);
+        let run_one = |wing: &mut Result<VirtualWing, SimulateError>, index: usize| {
+            let wing = wing.as_mut().map_err(|_| SimulateError::InvalidConfig {
+                field: "wing",
+                value: f64::NAN,
+                reason: "invalid",
+            })?;
+            let (states, family) = drive(index)?;
+            let mut rng = ChaCha8Rng::seed_from_u64(seed);
+            rng.set_stream(index as u64);
+            let t = wing.simulate_states(&states, &family, self.sampling, index, &errors, &mut rng);
+            progress();
+            t
+        };
+        let trajectories: Result<Vec<Trajectory>, SimulateError> = (0..n)
+            .into_par_iter()
+            .map_init(|| VirtualWing::new(self.wing), run_one)
+            .collect();
+        let trajectories = trajectories?;
+        let count = trajectories.len().max(1) as f64;
+        let mean_u_ref = trajectories.iter().map(|t| t.u_ref_m_s).sum::<f64>() / count;
+        let reynolds =
+            mean_u_ref * self.wing.wing.chord_m / self.wing.fluid.kinematic_viscosity_m2_s;
+        let mut settings = serde_json::json!({
+            "fidelity": self.wing.fidelity,
+            "sensor_errors": errors,
+            "mean_u_ref_m_s": mean_u_ref,
+            "mean_reynolds_number": reynolds,
+        });
+        if let (Some(all), serde_json::Value::Object(extra)) =
+            (settings.as_object_mut(), self.settings)
+        {
+            all.extend(extra);
+        }
+        let ds = Dataset {
+            meta: DatasetMeta {
+                format_version: FORMAT_VERSION,
+                wing: self.wing.wing.clone(),
+                fluid: self.wing.fluid.clone(),
+                generator: self.generator.to_string(),
+                seed: Some(self.seed),
+                settings,
+                input_units: INPUT_UNITS.iter().map(|s| s.to_string()).collect(),
+                output_units: OUTPUT_UNITS.iter().map(|s| s.to_string()).collect(),
+            },
+            dt_s: self.sampling.dataset_dt_s(),
+            trajectories,
+            n_train: self.n_train,
+        };
+        Ok(ValidDataset::new(ds)?)
+    }
 }
 
 #[cfg(test)]

@@ -36,6 +36,7 @@ __all__ = [
     "PRSSM",
     "Stream",
     "simulate",
+    "simulate_angles",
     "trajectories",
     "kinematics",
     "sysid",
@@ -86,6 +87,23 @@ def simulate(
     the same seed gives the same dataset as the CLI. ``fidelity``: ``l0`` quasi-steady,
     ``l1`` unsteady low-order, ``l2`` vortex method. ``progress(stage, position, total)``."""
     return _native.simulate(int(n), int(seed), fidelity, n_train, noise_free, flat, progress)
+
+
+def simulate_angles(
+    euler_rad: Any,
+    seed: int = 0,
+    fidelity: str = "l2",
+    n_train: Optional[int] = None,
+    noise_free: bool = False,
+    progress: Optional[Progress] = None,
+) -> "_native.Dataset":
+    """Simulates the virtual wing on given Euler angles ``(n, 470, 3)`` [φ, ψ, α] (rad) at
+    25 Hz — for example the paper's 548 measured trajectories
+    (``np.load("shared/data/bayiz2021-kinematics/euler_angles.npy")``): rates and
+    accelerations by a Savitzky–Golay fit, quintic Hermite interpolation to the wing's 250 Hz,
+    then the aerodynamics and the sensor chain as in :func:`simulate`."""
+    e = as_float_array("euler_rad", euler_rad, (None, 470, 3))
+    return _native.simulate_angles(e, int(seed), fidelity, n_train, noise_free, progress)
 
 
 def trajectories(n: int = 548, seed: int = 0, n_train: Optional[int] = None) -> "_native.Dataset":

@@ -118,6 +118,7 @@ impl Family {
 }
 
 mod fourier;
+pub mod measured;
 mod spec;
 
 pub use fourier::FourierSeries;
