@@ -15,15 +15,63 @@ pub struct FlapssmStream {
     u: Vec<f64>,
 }
 
-/// The input and output counts of a stream handle.
-pub(crate) trait Dims {
+/// What the C functions need of a stream handle.
+pub(crate) trait Handle {
     /// `(D_u, D_y)`.
     fn dims(&self) -> (usize, usize);
+    /// Back to `x₀ = 0` and the first draws.
+    fn reset(&mut self);
 }
 
-impl Dims for FlapssmStream {
+impl Handle for FlapssmStream {
     fn dims(&self) -> (usize, usize) {
         (self.stream.n_input(), self.stream.n_output())
+    }
+    fn reset(&mut self) {
+        self.stream.reset();
+    }
+}
+
+/// Resets a handle; `name` is the C function's, for the null-pointer message.
+///
+/// # Safety
+/// `stream` is null or a live handle.
+pub(crate) unsafe fn reset_handle<H: Handle>(stream: *mut H, name: &str) -> FlapssmStatus {
+    guard(|| {
+        // SAFETY: null or live, by the caller's contract.
+        match unsafe { stream.as_mut() } {
+            Some(s) => {
+                s.reset();
+                FlapssmStatus::Ok
+            }
+            None => fail(FlapssmStatus::NullArgument, format!("{name}: null stream")),
+        }
+    })
+}
+
+/// Frees a handle made by `Box::into_raw` (null is ignored).
+///
+/// # Safety
+/// `stream` is null or a live handle not freed before.
+pub(crate) unsafe fn free_handle<H>(stream: *mut H) {
+    if !stream.is_null() {
+        // SAFETY: a live handle from `Box::into_raw`, by the caller's contract.
+        drop(unsafe { Box::from_raw(stream) });
+    }
+}
+
+/// `FLAPSSM_STATUS_INVALID_VALUE` naming the first non-finite input, if any.
+pub(crate) fn check_finite<T: Copy + Into<f64>>(u: &[T]) -> Result<(), FlapssmStatus> {
+    match u
+        .iter()
+        .map(|&v| v.into())
+        .position(|v: f64| !v.is_finite())
+    {
+        Some(i) => Err(fail(
+            FlapssmStatus::InvalidValue,
+            format!("step: input {i} is not finite ({})", u[i].into()),
+        )),
+        None => Ok(()),
     }
 }
 
@@ -77,7 +125,7 @@ pub unsafe extern "C" fn flapssm_stream_new(
 ///
 /// # Safety
 /// As [`flapssm_stream_step`].
-pub(crate) unsafe fn with_arrays<H: Dims, T>(
+pub(crate) unsafe fn with_arrays<H: Handle, T>(
     stream: *mut H,
     u: *const T,
     n_input: usize,
@@ -191,11 +239,8 @@ pub unsafe extern "C" fn flapssm_stream_step_f32(
 
 /// One checked step; `write` receives the moments.
 fn step(stream: &mut LoadStream, u: &[f64], write: impl FnOnce(&[f64], &[f64])) -> FlapssmStatus {
-    if let Some(i) = u.iter().position(|v| !v.is_finite()) {
-        return fail(
-            FlapssmStatus::InvalidValue,
-            format!("step: input {i} is not finite ({})", u[i]),
-        );
+    if let Err(status) = check_finite(u) {
+        return status;
     }
     match stream.step(u) {
         Ok((m, v)) => {
@@ -213,19 +258,8 @@ fn step(stream: &mut LoadStream, u: &[f64], write: impl FnOnce(&[f64], &[f64])) 
 /// `stream` is null or a live handle.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn flapssm_stream_reset(stream: *mut FlapssmStream) -> FlapssmStatus {
-    guard(|| {
-        // SAFETY: null or live, by the caller's contract.
-        match unsafe { stream.as_mut() } {
-            Some(s) => {
-                s.stream.reset();
-                FlapssmStatus::Ok
-            }
-            None => fail(
-                FlapssmStatus::NullArgument,
-                "flapssm_stream_reset: null stream",
-            ),
-        }
-    })
+    // SAFETY: forwarded caller contract.
+    unsafe { reset_handle(stream, "flapssm_stream_reset") }
 }
 
 /// Frees a stream handle (null is ignored).
@@ -234,8 +268,6 @@ pub unsafe extern "C" fn flapssm_stream_reset(stream: *mut FlapssmStream) -> Fla
 /// `stream` is null or a handle from [`flapssm_stream_new`] not freed before.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn flapssm_stream_free(stream: *mut FlapssmStream) {
-    if !stream.is_null() {
-        // SAFETY: a live handle from `Box::into_raw`, by the caller's contract.
-        drop(unsafe { Box::from_raw(stream) });
-    }
+    // SAFETY: forwarded caller contract.
+    unsafe { free_handle(stream) }
 }

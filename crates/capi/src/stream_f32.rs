@@ -6,7 +6,7 @@ use flapssm_prssm::stream_f32::StreamPredictorF32;
 
 use crate::model::FlapssmModel;
 use crate::status::{FlapssmStatus, fail, guard};
-use crate::stream::{Dims, with_arrays};
+use crate::stream::{Handle, check_finite, free_handle, reset_handle, with_arrays};
 
 /// A single-precision streaming predictor (opaque). Allocated at creation; stepping and
 /// resetting allocate nothing.
@@ -16,9 +16,12 @@ pub struct FlapssmStreamF32 {
     dims: (usize, usize),
 }
 
-impl Dims for FlapssmStreamF32 {
+impl Handle for FlapssmStreamF32 {
     fn dims(&self) -> (usize, usize) {
         self.dims
+    }
+    fn reset(&mut self) {
+        self.stream.reset();
     }
 }
 
@@ -100,11 +103,8 @@ pub unsafe extern "C" fn flapssm_stream_f32_step(
             var,
             n_output,
             |s, u, mean, var| {
-                if let Some(i) = u.iter().position(|v| !v.is_finite()) {
-                    return fail(
-                        FlapssmStatus::InvalidValue,
-                        format!("step: input {i} is not finite ({})", u[i]),
-                    );
+                if let Err(status) = check_finite(u) {
+                    return status;
                 }
                 match s.stream.step(u) {
                     Ok((m, v)) => {
@@ -125,19 +125,8 @@ pub unsafe extern "C" fn flapssm_stream_f32_step(
 /// `stream` is null or a live handle.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn flapssm_stream_f32_reset(stream: *mut FlapssmStreamF32) -> FlapssmStatus {
-    guard(|| {
-        // SAFETY: null or live, by the caller's contract.
-        match unsafe { stream.as_mut() } {
-            Some(s) => {
-                s.stream.reset();
-                FlapssmStatus::Ok
-            }
-            None => fail(
-                FlapssmStatus::NullArgument,
-                "flapssm_stream_f32_reset: null stream",
-            ),
-        }
-    })
+    // SAFETY: forwarded caller contract.
+    unsafe { reset_handle(stream, "flapssm_stream_f32_reset") }
 }
 
 /// Frees a single-precision stream handle (null is ignored).
@@ -146,8 +135,6 @@ pub unsafe extern "C" fn flapssm_stream_f32_reset(stream: *mut FlapssmStreamF32)
 /// `stream` is null or a handle from [`flapssm_stream_f32_new`] not freed before.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn flapssm_stream_f32_free(stream: *mut FlapssmStreamF32) {
-    if !stream.is_null() {
-        // SAFETY: a live handle from `Box::into_raw`, by the caller's contract.
-        drop(unsafe { Box::from_raw(stream) });
-    }
+    // SAFETY: forwarded caller contract.
+    unsafe { free_handle(stream) }
 }

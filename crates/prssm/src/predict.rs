@@ -26,6 +26,28 @@ pub struct Prediction {
     pub latent_var: Vec<f64>,
 }
 
+/// The conditional of a predictor with `particles` particles, after checking the
+/// configuration, the parameters and the particle count.
+///
+/// # Errors
+/// [`ObjectiveError::Shape`] for invalid settings or zero particles; factorization errors.
+pub(crate) fn prediction_posterior(
+    config: &ModelConfig,
+    params: &Params,
+    particles: usize,
+) -> Result<Posterior, ObjectiveError> {
+    config
+        .check()
+        .map_err(|e| ObjectiveError::Shape(e.to_string()))?;
+    params
+        .check(config)
+        .map_err(|e| ObjectiveError::Shape(e.to_string()))?;
+    if particles == 0 {
+        return Err(ObjectiveError::Shape("particles must be ≥ 1".into()));
+    }
+    Posterior::new(config, params)
+}
+
 /// One transition step for `P` particles on caller buffers (for streaming prediction).
 #[derive(Debug, Clone)]
 pub struct StepPredictor {
@@ -49,16 +71,7 @@ impl StepPredictor {
         params: &Params,
         particles: usize,
     ) -> Result<Self, ObjectiveError> {
-        config
-            .check()
-            .map_err(|e| ObjectiveError::Shape(e.to_string()))?;
-        params
-            .check(config)
-            .map_err(|e| ObjectiveError::Shape(e.to_string()))?;
-        if particles == 0 {
-            return Err(ObjectiveError::Shape("particles must be ≥ 1".into()));
-        }
-        let post = Posterior::new(config, params)?;
+        let post = prediction_posterior(config, params, particles)?;
         // All particles share the input of a step.
         let ws = PredictiveWorkspace::new(&post, particles, particles);
         Ok(Self {

@@ -19,12 +19,11 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
 
-use crate::conditional::Posterior;
 use crate::kernel::KernelKind;
 use crate::model::PrssmModel;
 use crate::objective::ObjectiveError;
 use crate::params::CovarianceStructure;
-use crate::predict::StepDraws;
+use crate::predict::{StepDraws, prediction_posterior};
 
 /// A streaming predictor in single precision (see the module docs).
 #[derive(Debug, Clone)]
@@ -82,16 +81,7 @@ impl StreamPredictorF32 {
     /// not factorize.
     pub fn new(model: &PrssmModel, particles: usize, seed: u64) -> Result<Self, ObjectiveError> {
         let (config, params) = (&model.config, &model.params);
-        config
-            .check()
-            .map_err(|e| ObjectiveError::Shape(e.to_string()))?;
-        params
-            .check(config)
-            .map_err(|e| ObjectiveError::Shape(e.to_string()))?;
-        if particles == 0 {
-            return Err(ObjectiveError::Shape("particles must be ≥ 1".into()));
-        }
-        let post = Posterior::new(config, params)?;
+        let post = prediction_posterior(config, params, particles)?;
         let (m, d, dx) = (post.m, post.d, post.dx);
         let r = m + dx;
         let full = post.cov == CovarianceStructure::Full;
