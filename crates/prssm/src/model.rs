@@ -20,6 +20,47 @@ pub struct Normalization {
     pub output_std: Vec<f64>,
 }
 
+/// `out = (v − mean) / std` of a row-major table whose columns are the channels of `mean`,
+/// `std`. Allocates nothing.
+fn standardize_into(v: &[f64], mean: &[f64], std: &[f64], out: &mut [f64]) {
+    let d = mean.len().max(1);
+    for (i, (o, x)) in out.iter_mut().zip(v).enumerate() {
+        *o = (x - mean[i % d]) / std[i % d];
+    }
+}
+
+impl Normalization {
+    /// Standardized inputs `(u − mean) / std` of a row-major `T × D_u` table.
+    pub fn standardize_inputs(&self, inputs: &[f64]) -> Vec<f64> {
+        let mut z = vec![0.0; inputs.len()];
+        self.standardize_inputs_into(inputs, &mut z);
+        z
+    }
+
+    /// [`Self::standardize_inputs`] into `out` (as long as `inputs`). Allocates nothing.
+    pub fn standardize_inputs_into(&self, inputs: &[f64], out: &mut [f64]) {
+        standardize_into(inputs, &self.input_mean, &self.input_std, out);
+    }
+
+    /// Standardized outputs `(y − mean) / std` of a row-major `T × D_y` table.
+    pub fn standardize_outputs(&self, outputs: &[f64]) -> Vec<f64> {
+        let mut z = vec![0.0; outputs.len()];
+        standardize_into(outputs, &self.output_mean, &self.output_std, &mut z);
+        z
+    }
+
+    /// Output moments (row-major `T × D_y` means and variances) from standardized to physical
+    /// units, in place: means `m · std + mean`, variances `v · std²`. Allocates nothing.
+    pub fn outputs_to_physical(&self, mean: &mut [f64], var: &mut [f64]) {
+        let dy = self.output_std.len().max(1);
+        for (i, (m, v)) in mean.iter_mut().zip(var.iter_mut()).enumerate() {
+            let s = self.output_std[i % dy];
+            *m = *m * s + self.output_mean[i % dy];
+            *v *= s * s;
+        }
+    }
+}
+
 /// A PR-SSM with everything needed to predict.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct PrssmModel {
@@ -116,24 +157,12 @@ impl PrssmModel {
         seed: u64,
         keep_particles: bool,
     ) -> Result<(Prediction, Option<Vec<f64>>), ObjectiveError> {
-        let (dx, du, dy) = (
-            self.config.n_state,
-            self.config.n_input,
-            self.config.n_output,
-        );
-        let zero = vec![0.0; dx];
-        let standardized: Vec<f64>;
-        let z = match &self.normalization {
-            Some(n) => {
-                standardized = inputs
-                    .iter()
-                    .enumerate()
-                    .map(|(i, v)| (v - n.input_mean[i % du]) / n.input_std[i % du])
-                    .collect();
-                &standardized[..]
-            }
-            None => inputs,
-        };
+        let zero = vec![0.0; self.config.n_state];
+        let standardized = self
+            .normalization
+            .as_ref()
+            .map(|n| n.standardize_inputs(inputs));
+        let z = standardized.as_deref().unwrap_or(inputs);
         let (c, p) = (&self.config, &self.params);
         let (mut pred, all) = if keep_particles {
             let (pred, all) = predict::predict_particles(c, p, z, (&zero, &zero), particles, seed)?;
@@ -145,16 +174,7 @@ impl PrssmModel {
             )
         };
         if let Some(n) = &self.normalization {
-            for (i, (m, v)) in pred
-                .output_mean
-                .iter_mut()
-                .zip(pred.output_var.iter_mut())
-                .enumerate()
-            {
-                let s = n.output_std[i % dy];
-                *m = *m * s + n.output_mean[i % dy];
-                *v *= s * s;
-            }
+            n.outputs_to_physical(&mut pred.output_mean, &mut pred.output_var);
         }
         Ok((pred, all))
     }

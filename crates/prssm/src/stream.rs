@@ -188,14 +188,8 @@ impl StreamPredictor {
         }
         match &self.norm {
             Some(n) => {
-                for (i, (z, v)) in self.u_z.iter_mut().zip(u).enumerate() {
-                    *z = (v - n.input_mean[i]) / n.input_std[i];
-                }
-                for dd in 0..dy {
-                    let s = n.output_std[dd];
-                    self.out_mean[dd] = self.out_mean[dd] * s + n.output_mean[dd];
-                    self.out_var[dd] *= s * s;
-                }
+                n.standardize_inputs_into(u, &mut self.u_z);
+                n.outputs_to_physical(&mut self.out_mean, &mut self.out_var);
             }
             None => self.u_z.copy_from_slice(u),
         }

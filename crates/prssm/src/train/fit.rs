@@ -231,16 +231,9 @@ pub fn normalization<'a>(
 
 /// Standardizes a raw sequence with `norm` (a new sequence).
 pub fn standardize(s: SequenceView<'_>, norm: &Normalization) -> Sequence {
-    let z = |v: &[f64], mean: &[f64], std: &[f64]| -> Vec<f64> {
-        let d = mean.len().max(1);
-        v.iter()
-            .enumerate()
-            .map(|(i, x)| (x - mean[i % d]) / std[i % d])
-            .collect()
-    };
     Sequence {
-        inputs: z(s.inputs, &norm.input_mean, &norm.input_std),
-        outputs: z(s.outputs, &norm.output_mean, &norm.output_std),
+        inputs: norm.standardize_inputs(s.inputs),
+        outputs: norm.standardize_outputs(s.outputs),
     }
 }
 
@@ -455,22 +448,12 @@ pub fn predict_raw(
             params: Vec::new(),
         },
     };
-    let dy = model.config.n_output;
     let z = model.normalization.as_ref().map(|n| standardize(seq, n));
     let z = z.as_ref().map_or(seq, Sequence::view);
     let mut pred =
         predict_standardized(&model.config, &model.params, &initial, z, particles, seed)?;
     if let Some(n) = &model.normalization {
-        for (i, (m, v)) in pred
-            .output_mean
-            .iter_mut()
-            .zip(pred.output_var.iter_mut())
-            .enumerate()
-        {
-            let s = n.output_std[i % dy];
-            *m = *m * s + n.output_mean[i % dy];
-            *v *= s * s;
-        }
+        n.outputs_to_physical(&mut pred.output_mean, &mut pred.output_var);
     }
     Ok(pred)
 }
