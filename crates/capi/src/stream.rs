@@ -194,10 +194,14 @@ pub unsafe extern "C" fn flapssm_stream_step(
             var,
             n_output,
             |s, u, mean, var| {
-                step(&mut s.stream, u, |m, v| {
-                    mean.copy_from_slice(m);
-                    var.copy_from_slice(v);
-                })
+                checked_step(
+                    u,
+                    |u| s.stream.step(u),
+                    |m, v| {
+                        mean.copy_from_slice(m);
+                        var.copy_from_slice(v);
+                    },
+                )
             },
         )
     }
@@ -228,21 +232,30 @@ pub unsafe extern "C" fn flapssm_stream_step_f32(
             n_output,
             |s, u, mean, var| {
                 s.u.iter_mut().zip(u).for_each(|(d, &v)| *d = f64::from(v));
-                step(&mut s.stream, &s.u, |m, v| {
-                    mean.iter_mut().zip(m).for_each(|(d, &x)| *d = x as f32);
-                    var.iter_mut().zip(v).for_each(|(d, &x)| *d = x as f32);
-                })
+                checked_step(
+                    &s.u,
+                    |u| s.stream.step(u),
+                    |m, v| {
+                        mean.iter_mut().zip(m).for_each(|(d, &x)| *d = x as f32);
+                        var.iter_mut().zip(v).for_each(|(d, &x)| *d = x as f32);
+                    },
+                )
             },
         )
     }
 }
 
-/// One checked step; `write` receives the moments.
-fn step(stream: &mut LoadStream, u: &[f64], write: impl FnOnce(&[f64], &[f64])) -> FlapssmStatus {
+/// One checked step of any stream: `u` refused if not finite (the stream untouched), then
+/// `step(u)`, whose moments `write` receives; its error becomes `FLAPSSM_STATUS_INVALID_VALUE`.
+pub(crate) fn checked_step<'s, T: Copy + Into<f64> + 's, E: std::fmt::Display>(
+    u: &[T],
+    step: impl FnOnce(&[T]) -> Result<(&'s [T], &'s [T]), E>,
+    write: impl FnOnce(&[T], &[T]),
+) -> FlapssmStatus {
     if let Err(status) = check_finite(u) {
         return status;
     }
-    match stream.step(u) {
+    match step(u) {
         Ok((m, v)) => {
             write(m, v);
             FlapssmStatus::Ok

@@ -6,7 +6,7 @@ use flapssm_prssm::stream_f32::StreamPredictorF32;
 
 use crate::model::FlapssmModel;
 use crate::status::{FlapssmStatus, fail, guard};
-use crate::stream::{Handle, check_finite, free_handle, reset_handle, with_arrays};
+use crate::stream::{Handle, checked_step, free_handle, reset_handle, with_arrays};
 
 /// A single-precision streaming predictor (opaque). Allocated at creation; stepping and
 /// resetting allocate nothing.
@@ -103,17 +103,14 @@ pub unsafe extern "C" fn flapssm_stream_f32_step(
             var,
             n_output,
             |s, u, mean, var| {
-                if let Err(status) = check_finite(u) {
-                    return status;
-                }
-                match s.stream.step(u) {
-                    Ok((m, v)) => {
+                checked_step(
+                    u,
+                    |u| s.stream.step(u),
+                    |m, v| {
                         mean.copy_from_slice(m);
                         var.copy_from_slice(v);
-                        FlapssmStatus::Ok
-                    }
-                    Err(e) => fail(FlapssmStatus::InvalidValue, e.to_string()),
-                }
+                    },
+                )
             },
         )
     }

@@ -12,7 +12,7 @@ use numpy::{
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
-use crate::errors::{job_error, read_error};
+use crate::errors::{job_error, read_error, save_checked};
 use crate::progress::PyProgress;
 
 /// A validated wing dataset: `n` trajectories of `T` samples, the first `n_train` for
@@ -51,9 +51,10 @@ impl Dataset {
 
     /// Writes the dataset `.npz` file atomically.
     fn save(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
-        flapssm_jobs::files::check_outputs(&[&path], &[]).map_err(|e| job_error(e, None))?;
-        py.detach(|| self.inner.save(&path))
-            .map_err(|e| pyo3::exceptions::PyOSError::new_err(format!("{}: {e}", path.display())))
+        save_checked(&path, |p| {
+            py.detach(|| self.inner.save(p))
+                .map_err(|e| format!("{}: {e}", p.display()))
+        })
     }
 
     /// A dataset from arrays (checked by the Python layer for dtype and shape; validated

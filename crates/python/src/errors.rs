@@ -4,8 +4,8 @@
 use std::path::Path;
 
 use flapssm_jobs::JobError;
-use pyo3::PyErr;
 use pyo3::exceptions::{PyFileNotFoundError, PyKeyboardInterrupt, PyOSError, PyValueError};
+use pyo3::{PyErr, PyResult};
 
 /// The exception of a job error; `path`, when given, is the file the job read.
 pub fn job_error(e: JobError, path: Option<&Path>) -> PyErr {
@@ -31,4 +31,12 @@ pub fn read_error(path: &Path, message: String) -> PyErr {
     } else {
         PyFileNotFoundError::new_err(message)
     }
+}
+
+/// Writes an output file the way the CLI does: [`flapssm_jobs::files::check_outputs`] first
+/// (`OSError` for a directory, a device, `-`, a missing folder), then `save`, whose message
+/// becomes an `OSError`.
+pub fn save_checked(path: &Path, save: impl FnOnce(&Path) -> Result<(), String>) -> PyResult<()> {
+    flapssm_jobs::files::check_outputs(&[path], &[]).map_err(|e| job_error(e, None))?;
+    save(path).map_err(PyOSError::new_err)
 }

@@ -13,7 +13,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::dataset::Dataset;
-use crate::errors::{job_error, read_error};
+use crate::errors::{job_error, read_error, save_checked};
 
 /// A fitted LRQSM: one elastic net per output on the quasi-steady features, λ chosen by
 /// K-fold cross-validation (1-SE rule by default).
@@ -73,10 +73,7 @@ impl Lrqsm {
 
     /// Writes the model file atomically.
     fn save(&self, path: PathBuf) -> PyResult<()> {
-        flapssm_jobs::files::check_outputs(&[&path], &[]).map_err(|e| job_error(e, None))?;
-        self.model
-            .save(&path)
-            .map_err(|e| pyo3::exceptions::PyOSError::new_err(e.to_string()))
+        save_checked(&path, |p| self.model.save(p).map_err(|e| e.to_string()))
     }
 
     /// Predicted loads of every trajectory of `dataset`, `(n, T, 5)` (N, N·mm).

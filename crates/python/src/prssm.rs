@@ -14,7 +14,7 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
 use crate::dataset::Dataset;
-use crate::errors::{job_error, read_error};
+use crate::errors::{job_error, read_error, save_checked};
 use crate::progress::PyProgress;
 
 /// Arrays of a prediction: output mean, output variance, latent mean.
@@ -34,10 +34,6 @@ type StepMoments<'py> = PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1
 #[pyclass(module = "flapssm._native", frozen)]
 pub struct Prssm {
     pub(crate) model: PrssmModel,
-}
-
-fn prssm_error(what: &str, e: impl std::fmt::Display) -> PyErr {
-    PyValueError::new_err(format!("{what}: {e}"))
 }
 
 #[pymethods]
@@ -60,10 +56,7 @@ impl Prssm {
 
     /// Writes the model file atomically.
     fn save(&self, path: PathBuf) -> PyResult<()> {
-        flapssm_jobs::files::check_outputs(&[&path], &[]).map_err(|e| job_error(e, None))?;
-        self.model
-            .save(&path)
-            .map_err(|e| pyo3::exceptions::PyOSError::new_err(e.to_string()))
+        save_checked(&path, |p| self.model.save(p).map_err(|e| e.to_string()))
     }
 
     #[getter]
@@ -170,7 +163,7 @@ impl Prssm {
 
     /// The model file's JSON text.
     fn to_json(&self) -> PyResult<String> {
-        serde_json::to_string(&self.model).map_err(|e| prssm_error("model", e))
+        serde_json::to_string(&self.model).map_err(|e| PyValueError::new_err(format!("model: {e}")))
     }
 
     fn __repr__(&self) -> String {
