@@ -169,8 +169,14 @@ def test_evaluate_returns_the_metrics(small, tmp_path):
     report = flapssm.evaluate(small, tmp_path / "eval", prssm=model, lrqsm=lrqsm, particles=5)
     names = [m["model"] for m in report["models"]]
     assert names == ["PR-SSM", "LRQSM"]
-    assert (tmp_path / "eval" / "metrics.json").exists()
-    assert report["authority_findings"] is not None
+    # The dict is metrics.json, written in the folder.
+    assert json.loads((tmp_path / "eval" / "metrics.json").read_text()) == report
+    # Control authority of the PR-SSM's 5 latent states over the 7 inputs.
+    findings = report["authority_findings"]
+    labels = {"AoA", "|v|", "a_x", "a_y", "a_z", "dα/dt", "d²α/dt²"}
+    assert findings and {f["input"] for f in findings} <= labels
+    assert {f["state"] for f in findings} <= {f"x{i}" for i in range(1, 6)}
+    assert all(0.0 <= f["median_abs_r"] <= 1.0 for f in findings)
 
 
 def test_trajectories_kinematics_and_sysid_equal_the_cli(cli, tmp_path):
