@@ -23,6 +23,7 @@ pub mod authority;
 pub mod cycles_avg;
 pub mod error;
 pub mod kde;
+pub mod ks;
 pub mod metrics;
 #[cfg(feature = "plots")]
 pub mod plots;

@@ -107,7 +107,7 @@ pub fn prctile_sorted(sorted: &[f64], p: f64) -> Result<f64> {
 }
 
 /// Sorts a copy of `values` after checking they are finite.
-fn sorted_copy(what: &str, values: &[f64]) -> Result<Vec<f64>> {
+pub(crate) fn sorted_copy(what: &str, values: &[f64]) -> Result<Vec<f64>> {
     check_finite(what, values)?;
     if values.is_empty() {
         return Err(AnalysisError::Empty { what: what.into() });

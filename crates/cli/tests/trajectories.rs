@@ -75,3 +75,79 @@ fn bad_arguments_are_refused_and_write_nothing() {
     assert!(String::from_utf8_lossy(&o.stderr).contains("--n"));
     assert!(!out.exists());
 }
+
+#[test]
+fn compare_paper_prints_every_statistic_and_needs_no_output_file() {
+    let text = ok(&[
+        "trajectories",
+        "--n",
+        "40",
+        "--seed",
+        "1",
+        "--compare-paper",
+    ]);
+    for name in flapssm_wing::trajectories::stats::STAT_NAMES {
+        assert!(text.contains(name), "{name} missing from:\n{text}");
+    }
+    assert!(text.contains("KS D"), "{text}");
+    // The hovering preset flaps about twice as fast as the paper's robot: its frequency row
+    // differs from the default's.
+    let hovering = ok(&[
+        "trajectories",
+        "--n",
+        "40",
+        "--seed",
+        "1",
+        "--compare-paper",
+        "--preset",
+        "hovering",
+    ]);
+    let row = |t: &str| {
+        t.lines()
+            .find(|l| l.starts_with("stroke frequency"))
+            .unwrap()
+            .to_string()
+    };
+    assert_ne!(row(&text), row(&hovering));
+    // Neither an output nor a comparison: a usage error.
+    let o = flapssm(&["trajectories", "--n", "4"]);
+    assert_eq!(o.status.code(), Some(2));
+}
+
+#[test]
+fn simulate_drives_the_wing_with_the_papers_trajectories() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("p.npz");
+    let text = ok(&[
+        "simulate",
+        "--source",
+        "paper",
+        "--n",
+        "3",
+        "--fidelity",
+        "l0",
+        "--quiet",
+        "--out",
+        s(&out),
+    ]);
+    assert!(text.contains("measured (the paper's)"), "{text}");
+    let ds = Dataset::load(&out).unwrap();
+    assert_eq!((ds.len(), ds.n_train), (3, 2));
+    assert!(ds.trajectories.iter().all(|t| t.family == "measured"));
+    let source = ds.meta.settings["angles_source"].as_str().unwrap();
+    assert!(source.contains("0..3"), "{source}");
+    // Re ≈ 1000 with the default fluid (ν from the paper's Re and the measured U_ref).
+    let re = ds.meta.settings["mean_reynolds_number"].as_f64().unwrap();
+    assert!((950.0..1050.0).contains(&re), "Re {re}");
+    let bad = dir.path().join("q.npz");
+    let o = flapssm(&[
+        "simulate",
+        "--source",
+        "paper",
+        "--n",
+        "549",
+        "--out",
+        s(&bad),
+    ]);
+    assert_fails(&o, &["setting n = 549", "548"], &bad);
+}

@@ -64,16 +64,22 @@ pub fn read_npy_f64(path: impl AsRef<Path>) -> Result<Array<f64>, NpzError> {
         path: path.to_path_buf(),
         source,
     })?;
-    split_npy(&bytes)
-        .and_then(|(h, p)| decode_numeric(&h, p))
-        .map_err(|message| NpzError::Malformed {
-            path: path.to_path_buf(),
-            name: path
-                .file_name()
-                .map(|n| n.to_string_lossy().into_owned())
-                .unwrap_or_default(),
-            message,
-        })
+    decode_npy_f64(&bytes).map_err(|message| NpzError::Malformed {
+        path: path.to_path_buf(),
+        name: path
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default(),
+        message,
+    })
+}
+
+/// Decodes a whole `.npy` byte buffer (any numeric dtype, C or Fortran order) as `f64`.
+///
+/// # Errors
+/// What is wrong with the header or the payload.
+pub fn decode_npy_f64(bytes: &[u8]) -> Result<Array<f64>, String> {
+    split_npy(bytes).and_then(|(h, p)| decode_numeric(&h, p))
 }
 
 /// An array read from a `.npy` member: its shape and its values in C order.

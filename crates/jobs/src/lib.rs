@@ -5,7 +5,8 @@
 //!
 //! | module | job |
 //! |---|---|
-//! | [`simulate`] | the virtual wing on seeded random trajectories, into a dataset |
+//! | [`simulate`] | the virtual wing on seeded random or the paper's measured trajectories, into a dataset |
+//! | [`kinematics_compare`] | the generator's trajectory statistics beside the paper's measured set |
 //! | [`train`] | PR-SSM training on a dataset's training trajectories (settings, checkpoints, resume) |
 //! | [`predict`] | open-loop predictions of every trajectory of a dataset (PR-SSM, LRQSM) |
 //! | [`stream`] | real-time PR-SSM prediction, one sample at a time (CSV in, CSV out) |
@@ -27,6 +28,7 @@ pub mod demo;
 pub mod error;
 pub mod evaluate;
 pub mod files;
+pub mod kinematics_compare;
 pub mod models;
 pub mod predict;
 pub mod progress;

@@ -4,6 +4,7 @@ use std::path::Path;
 
 use flapssm_wing::dataset::ValidDataset;
 use flapssm_wing::sensor::SensorConfig;
+use flapssm_wing::trajectories::paper::{PAPER_ANGLE_SIGNS, PAPER_N_TRAJECTORIES, paper_angles};
 use flapssm_wing::trajectories::{GeneratorConfig, default_n_train};
 use flapssm_wing::virtual_wing::{
     Fidelity, SimulationConfig, VirtualWingConfig, simulate_angles_dataset, simulate_dataset,
@@ -124,6 +125,7 @@ pub fn simulate(
 pub fn simulate_angles(
     settings: &SimulateSettings,
     angles_rad: &[Vec<[f64; 3]>],
+    source: &str,
     progress: &dyn Progress,
 ) -> Result<ValidDataset> {
     if settings.n_trajectories != angles_rad.len() {
@@ -141,10 +143,45 @@ pub fn simulate_angles(
         &cfg.trajectories.sampling,
         settings.seed,
         cfg.trajectories.n_train,
+        source,
         &|| progress.advance(1),
     )?;
     progress.finish(&format!("{} trajectories", ds.len()));
     Ok(ds)
+}
+
+/// Simulates the wing of `settings` on the paper's measured trajectories
+/// ([`flapssm_wing::trajectories::paper`]): the first `n_trajectories` (at most 548, in the
+/// authors' order; all 548 give the published split, 512 training and the paper's 36 test
+/// trajectories last).
+///
+/// # Errors
+/// [`JobError::Setting`] for more than 548 trajectories, `flat` (the measured deviation is
+/// what it is) or a bad split.
+pub fn simulate_paper(
+    settings: &SimulateSettings,
+    progress: &dyn Progress,
+) -> Result<ValidDataset> {
+    let n = settings.n_trajectories;
+    if n > PAPER_N_TRAJECTORIES {
+        return Err(JobError::Setting {
+            name: "n".into(),
+            value: n.to_string(),
+            expected: format!("at most the paper's {PAPER_N_TRAJECTORIES} measured trajectories"),
+        });
+    }
+    if settings.flat {
+        return Err(JobError::Setting {
+            name: "flat".into(),
+            value: "true".into(),
+            expected: "not with the measured trajectories (their deviation is measured)".into(),
+        });
+    }
+    let source = format!(
+        "Bayiz & Cheng (2021) measured trajectories 0..{n} (crates/wing/data/bayiz2021-euler-angles.npy, \
+         signs {PAPER_ANGLE_SIGNS:?} to [stroke, deviation, pitch])"
+    );
+    simulate_angles(settings, &paper_angles(n), &source, progress)
 }
 
 #[cfg(test)]
@@ -181,6 +218,43 @@ mod tests {
             .check()
             .unwrap_err();
             assert!(e.to_string().contains(name), "{e}");
+        }
+    }
+
+    #[test]
+    fn the_papers_trajectories_are_a_source_with_the_published_split() {
+        let settings = SimulateSettings {
+            n_trajectories: 3,
+            noise_free: true,
+            fidelity: flapssm_wing::virtual_wing::Fidelity::L0,
+            ..SimulateSettings::default()
+        };
+        let ds = simulate_paper(&settings, &NoProgress).unwrap();
+        assert_eq!(ds.len(), 3);
+        assert_eq!(ds.trajectories[0].family, "measured");
+        let src = ds.meta.settings["angles_source"].as_str().unwrap();
+        assert!(src.contains("0..3"), "{src}");
+        let first = paper_angles(1);
+        let d = (ds.trajectories[0].euler_rad[200][2] - first[0][200][2]).abs();
+        assert!(d < 0.02, "pitch differs by {d} rad from the measured one");
+        for (bad, name) in [
+            (
+                SimulateSettings {
+                    n_trajectories: 549,
+                    ..settings
+                },
+                "setting n = 549",
+            ),
+            (
+                SimulateSettings {
+                    flat: true,
+                    ..settings
+                },
+                "setting flat",
+            ),
+        ] {
+            let e = simulate_paper(&bad, &NoProgress).unwrap_err().to_string();
+            assert!(e.contains(name), "{e}");
         }
     }
 }

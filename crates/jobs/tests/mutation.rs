@@ -49,6 +49,7 @@ fn fixtures(dir: &Path) -> Vec<(&'static str, PathBuf, Reader)> {
     cfg.trajectories.n_train = 2;
     cfg.trajectories.seed = 1;
     cfg.trajectories.sampling.n_samples = 200;
+    cfg.trajectories.frequency_hz = [0.2, 0.3];
     let ds = simulate_dataset(&cfg, &|| {}).unwrap();
     let npz = dir.join("d.npz");
     ds.save(&npz).unwrap();

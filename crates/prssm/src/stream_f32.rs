@@ -1,7 +1,7 @@
 //! Single-precision streaming prediction, for flight computers whose FPU has no (fast) double
 //! precision: the particles, the kernel, the products and the moments in `f32`; the model's
 //! factorization (`K_mm`, `G = (K_mm + jitter·I)⁻¹` or `L⁻¹`, `mᵀG`) done once in `f64` by
-//! [`Posterior::new`] and rounded.
+//! [`Posterior::new`](crate::conditional::Posterior::new) and rounded.
 //!
 //! The step is [`crate::stream::StreamPredictor`]'s with the same draws (the `f64` standard
 //! normals of the same seed, rounded): per particle `c`, `z = [x_c; u] / ℓ`,

@@ -303,6 +303,31 @@ pub fn kinematics<'py>(
     PyArray1::from_vec(py, flat).reshape([t, 7])
 }
 
+/// The paper's measured trajectories `0..n` (default all 548; Bayiz & Cheng 2021, vendored) as
+/// Euler angles `(n, 470, 3)` [φ, ψ, α] (rad, 25 Hz) in flapssm's convention (the file's
+/// deviation and pitch negated; docs/kinematics.md).
+#[pyfunction]
+#[pyo3(signature = (n=None))]
+pub fn paper_angles<'py>(
+    py: Python<'py>,
+    n: Option<usize>,
+) -> PyResult<Bound<'py, numpy::PyArray3<f64>>> {
+    use flapssm_wing::trajectories::paper::{PAPER_N_SAMPLES, PAPER_N_TRAJECTORIES};
+    let n = n.unwrap_or(PAPER_N_TRAJECTORIES);
+    if n > PAPER_N_TRAJECTORIES {
+        return Err(PyValueError::new_err(format!(
+            "n = {n}: at most the paper's {PAPER_N_TRAJECTORIES} measured trajectories"
+        )));
+    }
+    let flat: Vec<f64> = flapssm_wing::trajectories::paper::paper_angles(n)
+        .iter()
+        .flatten()
+        .flatten()
+        .copied()
+        .collect();
+    PyArray1::from_vec(py, flat).reshape([n, PAPER_N_SAMPLES, 3])
+}
+
 /// Simulates the virtual wing on given Euler angles `(n, 470, 3)` (rad, 25 Hz; the paper's
 /// measured trajectories): the same wing, sensor and split settings as [`simulate`].
 #[pyfunction]
@@ -333,7 +358,9 @@ pub fn simulate_angles(
         flat: false,
     };
     let bar = PyProgress::new(progress);
-    let ds = py.detach(|| flapssm_jobs::simulate::simulate_angles(&settings, &angles, &bar));
+    let ds = py.detach(|| {
+        flapssm_jobs::simulate::simulate_angles(&settings, &angles, "Python arrays", &bar)
+    });
     if let Some(e) = bar.take_error() {
         return Err(e);
     }

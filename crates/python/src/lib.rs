@@ -20,6 +20,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<prssm::Stream>()?;
     m.add_function(wrap_pyfunction!(dataset::simulate, m)?)?;
     m.add_function(wrap_pyfunction!(dataset::simulate_angles, m)?)?;
+    m.add_function(wrap_pyfunction!(dataset::paper_angles, m)?)?;
     m.add_function(wrap_pyfunction!(dataset::trajectories, m)?)?;
     m.add_function(wrap_pyfunction!(dataset::kinematics, m)?)?;
     m.add_function(wrap_pyfunction!(sysid::sysid, m)?)?;

@@ -16,6 +16,14 @@
 //! 6. white noise σ_F, σ_M; 7. quantisation to 1/320 N and 1/64 N·mm;
 //! 8. zero-phase low-pass: 4th-order Butterworth (two bilinear biquads) run forward and
 //!    backward (cut-off 5 Hz, −6 dB at the cut-off), then decimation (every 10th sample).
+//!
+//! **Tare** (`tare`, on by default): before each trajectory the wing rests at the home pose
+//! (`home_pose_deg`; the authors' `[0, 0, −90]°`, the horizontal plate) and the reading is
+//! zeroed, as a rig operator does. What the tare removes is what is constant over the
+//! trajectory: the per-trajectory bias (step 4: the offset starts at zero and the drift
+//! accumulates from the tare) and the static residual at the home pose (step 1 becomes
+//! ε_s·(y_static − y_static,home)). The noise of the tare reading itself (an average over many
+//! samples) is neglected.
 
 use rand::Rng;
 use rand_chacha::ChaCha8Rng;
@@ -81,6 +89,13 @@ pub struct SensorConfig {
     pub encoder: bool,
     /// Encoder counts per revolution (4096).
     pub encoder_counts_per_rev: u32,
+    /// Zero the reading at the home pose before each trajectory (true; false for files written
+    /// before the tare existed).
+    #[serde(default)]
+    pub tare: bool,
+    /// Home pose [φ, ψ, α] (deg) of the tare: [0, 0, 90], the authors' `[0, 0, −90]` in this
+    /// crate's pitch sign (docs/kinematics.md) — the horizontal plate.
+    pub home_pose_deg: [f64; 3],
 }
 
 impl Default for SensorConfig {
@@ -112,6 +127,8 @@ impl Default for SensorConfig {
             cutoff_hz: 5.0,
             encoder: true,
             encoder_counts_per_rev: 4096,
+            tare: true,
+            home_pose_deg: [0.0, 0.0, 90.0],
         }
     }
 }
@@ -129,6 +146,7 @@ impl SensorConfig {
             quantization: false,
             lowpass: false,
             encoder: false,
+            tare: false,
             ..Self::default()
         }
     }
@@ -244,8 +262,9 @@ pub fn filtfilt(sections: &[Biquad; 2], x: &mut [f64], pad: usize, work: &mut Ve
 /// Applies steps 1–8 of the module docs to one trajectory's raw loads and decimates.
 ///
 /// `raw` holds the raw loads (one row per raw sample, in place: modified), `static_loads` and
-/// `inertial_loads` the rigid-plate loads on the same grid, `rng` the trajectory's stream.
-/// Returns every `decimation`-th sample, starting at 0.
+/// `inertial_loads` the rigid-plate loads on the same grid, `home_static` the static load at the
+/// home pose (used with `cfg.tare`), `rng` the trajectory's stream. Returns every
+/// `decimation`-th sample, starting at 0.
 #[allow(clippy::too_many_arguments)]
 pub fn measure(
     cfg: &SensorConfig,
@@ -253,6 +272,7 @@ pub fn measure(
     raw: &mut [[f64; 5]],
     static_loads: &[[f64; 5]],
     inertial_loads: &[[f64; 5]],
+    home_static: &[f64; 5],
     raw_rate_hz: f64,
     decimation: usize,
     rng: &mut ChaCha8Rng,
@@ -266,9 +286,10 @@ pub fn measure(
             cfg.moment_full_scale_n_mm
         }
     };
+    let tared = if cfg.tare { *home_static } else { [0.0; 5] };
     for ((y, ys), yi) in raw.iter_mut().zip(static_loads).zip(inertial_loads) {
         for c in 0..5 {
-            y[c] += errors.static_residual * ys[c] + errors.inertial_residual * yi[c];
+            y[c] += errors.static_residual * (ys[c] - tared[c]) + errors.inertial_residual * yi[c];
         }
         if cfg.cross_axis {
             // E acts on full-scale-normalized signals (calibration-matrix error).
@@ -295,7 +316,8 @@ pub fn measure(
             .zip(raw.iter())
             .for_each(|(v, y)| *v = y[c]);
         if cfg.bias_drift {
-            let mut offset = cfg.bias_frac_fs * fs(c) * std.sample(rng);
+            let bias = cfg.bias_frac_fs * fs(c) * std.sample(rng);
+            let mut offset = if cfg.tare { 0.0 } else { bias };
             let step_sd = cfg.drift_frac_fs * fs(c) * (dt / 20.0).sqrt();
             for v in column.iter_mut() {
                 *v += offset;
@@ -371,6 +393,56 @@ mod tests {
         assert!(c.iter().all(|v| (v - 3.5).abs() < 1e-12));
     }
 
+    /// At rest in the home pose, the tared reading is zero whatever the bias and the static
+    /// residual; untared, it is the bias plus ε_s·y_static,home. Away from home the tare leaves
+    /// ε_s·(y_static − y_static,home).
+    #[test]
+    fn the_tare_removes_the_bias_and_the_static_residual_at_home() {
+        let n = 2500;
+        let home = [0.3, -0.2, 5.0, 7.0, -1.0];
+        let cfg = SensorConfig {
+            static_residual: true,
+            bias_drift: true,
+            drift_frac_fs: 0.0,
+            tare: true,
+            ..SensorConfig::noise_free()
+        };
+        let mut rng = ChaCha8Rng::seed_from_u64(4);
+        let errs = DatasetSensorErrors::draw(&cfg, &mut rng);
+        let zeros = vec![[0.0; 5]; n];
+        let at_home = vec![home; n];
+        let run = |cfg: &SensorConfig, statics: &[[f64; 5]]| {
+            let mut rng = ChaCha8Rng::seed_from_u64(9);
+            let mut raw = vec![[0.0; 5]; n];
+            measure(
+                cfg, &errs, &mut raw, statics, &zeros, &home, 250.0, 10, &mut rng,
+            )
+        };
+        assert!(
+            run(&cfg, &at_home)
+                .iter()
+                .flatten()
+                .all(|v| v.abs() < 1e-15)
+        );
+        let untared = run(
+            &SensorConfig {
+                tare: false,
+                ..cfg.clone()
+            },
+            &at_home,
+        );
+        let first = untared[0];
+        assert!(untared.iter().all(|y| *y == first));
+        assert!(
+            (first[0] - errs.static_residual * home[0]).abs() > 1e-6,
+            "a bias is present"
+        );
+        let away = vec![[1.3, -0.2, 5.0, 9.0, -1.0]; n];
+        let tared = run(&cfg, &away);
+        assert!((tared[5][0] - errs.static_residual * 1.0).abs() < 1e-12);
+        assert!((tared[5][3] - errs.static_residual * 2.0).abs() < 1e-12);
+    }
+
     #[test]
     fn noise_free_is_identity_and_noise_has_expected_size() {
         let n = 4700;
@@ -382,7 +454,9 @@ mod tests {
         let cfg = SensorConfig::noise_free();
         let errs = DatasetSensorErrors::draw(&cfg, &mut rng);
         let mut raw = clean.clone();
-        let out = measure(&cfg, &errs, &mut raw, &zeros, &zeros, 250.0, 10, &mut rng);
+        let out = measure(
+            &cfg, &errs, &mut raw, &zeros, &zeros, &[0.0; 5], 250.0, 10, &mut rng,
+        );
         assert_eq!(out.len(), 470);
         for (k, y) in out.iter().enumerate() {
             assert_eq!(*y, clean[10 * k]);
@@ -395,7 +469,9 @@ mod tests {
             ..SensorConfig::noise_free()
         };
         let mut raw = vec![[0.0; 5]; n];
-        let out = measure(&cfg, &errs, &mut raw, &zeros, &zeros, 250.0, 10, &mut rng);
+        let out = measure(
+            &cfg, &errs, &mut raw, &zeros, &zeros, &[0.0; 5], 250.0, 10, &mut rng,
+        );
         let sd = (out.iter().map(|y| y[0] * y[0]).sum::<f64>() / out.len() as f64).sqrt();
         let expect = 0.008 * (0.9 * 5.0 / 125.0f64).sqrt();
         assert!((sd / expect - 1.0).abs() < 0.25, "{sd} vs {expect}");
@@ -405,7 +481,9 @@ mod tests {
             let cfg = SensorConfig::default();
             let errs = DatasetSensorErrors::draw(&cfg, &mut rng);
             let mut raw = clean.clone();
-            measure(&cfg, &errs, &mut raw, &zeros, &zeros, 250.0, 10, &mut rng)
+            measure(
+                &cfg, &errs, &mut raw, &zeros, &zeros, &[0.0; 5], 250.0, 10, &mut rng,
+            )
         };
         assert_eq!(run(7), run(7));
         assert_ne!(run(7), run(8));

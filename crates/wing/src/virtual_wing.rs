@@ -125,7 +125,8 @@ pub struct VirtualWingConfig {
     pub fidelity: Fidelity,
     /// Plate geometry (0.18 × 0.06 m, r0 = 0.055 m, pitch axis at 15 % chord, U_ref at 0.235 m).
     pub wing: WingGeometry,
-    /// Fluid (ρ = 800 kg/m³, ν = 2.2e-5 m²/s: Re = U_ref c/ν ≈ 1000 at U_ref ≈ 0.37 m/s).
+    /// Fluid (ρ = 800 kg/m³, ν = 1.05e-5 m²/s: Re = U_ref c/ν ≈ 1000 at the measured
+    /// trajectories' U_ref = 0.175 m/s; see [`Fluid::default`]).
     pub fluid: Fluid,
     /// Sensor origin on the pitch axis, distance from the stroke axis (m; 0.055 = wing root).
     pub sensor_radius_m: f64,
@@ -191,6 +192,13 @@ impl VirtualWingConfig {
             ("sensor.cutoff_hz", self.sensor.cutoff_hz),
             ("wing.u_ref_radius_m", self.wing.u_ref_radius_m),
         ];
+        if let Some(v) = self.sensor.home_pose_deg.iter().find(|v| !v.is_finite()) {
+            return Err(SimulateError::InvalidConfig {
+                field: "sensor.home_pose_deg",
+                value: *v,
+                reason: "must be finite",
+            });
+        }
         if let Some((field, value)) = first_not_positive(&positive) {
             return Err(SimulateError::InvalidConfig {
                 field,
@@ -363,12 +371,17 @@ impl VirtualWing {
             } else {
                 (vec![[0.0; 5]; states.len()], vec![[0.0; 5]; states.len()])
             };
+        let home = EulerState {
+            angles_rad: self.cfg.sensor.home_pose_deg.map(f64::to_radians),
+            ..EulerState::default()
+        };
         let mut outputs = measure(
             &self.cfg.sensor,
             errors,
             &mut raw,
             &static_loads,
             &inertial_loads,
+            &self.plate_loads(&home).0,
             sampling.raw_rate_hz,
             sampling.decimation,
             rng,
@@ -463,7 +476,8 @@ pub fn simulate_dataset(
 /// paper's measured trajectories: 470 at 25 Hz), driven at the raw rate by
 /// [`crate::trajectories::measured::raw_states`]. The sensor noise is seeded by `seed`, the
 /// first `n_train` trajectories are the training set, family label `"measured"`, generator
-/// `"flapssm simulate (given angles)"`.
+/// `"flapssm simulate (given angles)"`; `source` (where the angles come from) is recorded in
+/// the metadata's settings as `angles_source`.
 ///
 /// # Errors
 /// A trajectory of the wrong length or too short to differentiate
@@ -474,6 +488,7 @@ pub fn simulate_angles_dataset(
     sampling: &crate::trajectories::SamplingConfig,
     seed: u64,
     n_train: usize,
+    source: &str,
     progress: &(dyn Fn() + Sync),
 ) -> Result<ValidDataset, SimulateError> {
     wing.check()?;
@@ -489,7 +504,7 @@ pub fn simulate_angles_dataset(
         seed,
         n_train,
         generator: "flapssm simulate (given angles)",
-        settings: serde_json::json!({ "wing": wing, "sampling": sampling }),
+        settings: serde_json::json!({ "wing": wing, "sampling": sampling, "angles_source": source }),
     };
     run.simulate(angles_rad.len(), &drive, progress)
 }

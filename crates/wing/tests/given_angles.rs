@@ -42,19 +42,26 @@ fn given_25_hz_angles_reproduce_the_analytic_drive() {
                     .collect()
             })
             .collect();
-        let given =
-            simulate_angles_dataset(&cfg.wing, &angles, &trajectories.sampling, 6, 2, &|| {})
-                .unwrap();
+        let given = simulate_angles_dataset(
+            &cfg.wing,
+            &angles,
+            &trajectories.sampling,
+            6,
+            2,
+            "test",
+            &|| {},
+        )
+        .unwrap();
         assert_eq!((given.len(), given.n_train), (3, 2));
         assert_eq!(given.meta.generator, "flapssm simulate (given angles)");
-        // Away from the start (the differentiator's edge), loads agree to 1e-3 of each
-        // output's spread (measured: ≤ 2e-4).
+        // Past the given drive's ramp-in from rest (2 s, 50 samples) and the differentiator's
+        // edge, loads agree within 3e-2 of each output's spread (measured: ≤ 1.3e-3).
         for k in 0..5 {
             let (mut num, mut den) = (0.0, 0.0);
             for (a, g) in analytic.trajectories.iter().zip(&given.trajectories) {
                 let (ya, yg) = (a.outputs.as_ref().unwrap(), g.outputs.as_ref().unwrap());
                 let mean = ya.iter().map(|y| y[k]).sum::<f64>() / ya.len() as f64;
-                for t in 20..ya.len() {
+                for t in 60..ya.len() {
                     num += (ya[t][k] - yg[t][k]).powi(2);
                     den += (ya[t][k] - mean).powi(2);
                 }
@@ -71,32 +78,27 @@ fn given_25_hz_angles_reproduce_the_analytic_drive() {
 
 #[test]
 fn the_papers_measured_trajectories_give_a_valid_dataset() {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../../shared/data/bayiz2021-kinematics/euler_angles.npy");
-    let arr = flapssm_data::npz::read_npy_f64(&path).unwrap();
-    assert_eq!(arr.shape, vec![548, 470, 3]);
-    let angles: Vec<Vec<[f64; 3]>> = arr
-        .data
-        .chunks_exact(470 * 3)
-        .take(2)
-        .map(|t| t.chunks_exact(3).map(|r| [r[0], r[1], r[2]]).collect())
-        .collect();
+    let angles = flapssm_wing::trajectories::paper::paper_angles(2);
     let ds = simulate_angles_dataset(
         &noise_free(Fidelity::L1),
         &angles,
         &Default::default(),
         1,
         1,
+        "the paper's first two",
         &|| {},
     )
     .unwrap();
     assert!(ds.has_outputs() && ds.len() == 2);
-    // The dataset's angles are the measured ones, smoothed: within a degree.
+    // Past the ramp-in from rest (50 samples) the dataset's angles are the measured ones,
+    // smoothed: within a degree; the drive starts at rest at the first measured pose.
     for (t, a) in ds.trajectories.iter().zip(&angles) {
-        let worst = t
-            .euler_rad
+        for (x, y) in t.euler_rad[0].iter().zip(&a[0]) {
+            assert!((x - y).abs() < 1f64.to_radians());
+        }
+        let worst = t.euler_rad[50..]
             .iter()
-            .zip(a)
+            .zip(&a[50..])
             .flat_map(|(x, y)| (0..3).map(move |k| (x[k] - y[k]).abs()))
             .fold(0.0, f64::max);
         assert!(worst < 1f64.to_radians(), "{worst}");

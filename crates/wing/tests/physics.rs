@@ -327,7 +327,7 @@ fn wing(fidelity: Fidelity) -> VirtualWing {
 }
 
 fn generated_states(dt_s: f64, n: usize) -> Vec<EulerState> {
-    let spec = GeneratorConfig::default()
+    let spec = GeneratorConfig::hovering()
         .generate_one(3, Family::FigureEight)
         .unwrap();
     (0..n).map(|k| spec.euler_state(k as f64 * dt_s)).collect()
@@ -538,7 +538,7 @@ fn default_strip_count_is_converged() {
     }
 }
 
-/// `simulate_dataset` of `n` default-generator trajectories (the first `n_train` for training,
+/// `simulate_dataset` of `n` hovering-generator trajectories (the first `n_train` for training,
 /// seed `seed`) on `wing` with every sensor effect off.
 fn noise_free_dataset(
     mut wing: VirtualWingConfig,
@@ -556,14 +556,14 @@ fn noise_free_dataset(
             n_trajectories: n,
             n_train,
             seed,
-            ..Default::default()
+            ..GeneratorConfig::hovering()
         },
     };
     simulate_dataset(&cfg, &|| {}).unwrap()
 }
 
 /// `simulate` at L2 (strip LDVM, 2 strips): every load finite on random trajectories of the
-/// default generator, and the same size as L0 (least-squares slope of L2 on L0 F_x; measured
+/// hovering generator, and the same size as L0 (least-squares slope of L2 on L0 F_x; measured
 /// on these 3 trajectories: slope 0.87, uncentred correlation 0.97; L1 is about half of L0).
 #[test]
 fn l2_dataset_is_finite_and_sized_like_l0() {
@@ -619,15 +619,16 @@ fn invalid_l2_settings_are_refused_by_name() {
     assert!(cfg.check().is_ok());
 }
 
-/// Raw noise-free loads of trajectories `indices` of the default generator (seed 1, 548
-/// trajectories), all run in order on one reused wing `cfg`.
+/// Raw noise-free loads of trajectories `indices` of the hovering generator (seed 1, 548
+/// trajectories; the generator these regression cases were found on), all run in order on one
+/// reused wing `cfg`.
 fn raw_loads_on_one_wing(cfg: &VirtualWingConfig, indices: &[usize]) -> Vec<Vec<[f64; 5]>> {
     use flapssm_wing::trajectories::{GeneratorConfig, default_n_train};
     let gen_cfg = GeneratorConfig {
         n_trajectories: 548,
         n_train: default_n_train(548),
         seed: 1,
-        ..Default::default()
+        ..GeneratorConfig::hovering()
     };
     let specs = gen_cfg.generate().unwrap();
     let dt = gen_cfg.sampling.raw_dt_s();
@@ -679,7 +680,7 @@ fn assert_peak_force_below_15_n(cfg: &VirtualWingConfig, indices: &[usize], labe
     }
 }
 
-/// Default-generator trajectories on which L2 blew up (|F| of 10⁵ N from a strong wake vortex
+/// Hovering-generator trajectories on which L2 blew up (|F| of 10⁵ N from a strong wake vortex
 /// met at the leading edge, before the LEV sign check and the viscous core growth) stay bounded:
 /// the noise-free L0 loads of the generator peak at a few newtons.
 #[test]
@@ -708,7 +709,7 @@ fn l2_lev_chain_stays_on_the_suction_side_with_large_cores() {
     }
 }
 
-/// Noise-free L2 outputs [F_x … M_z] of 24 default-generator trajectories (seed 2021) from
+/// Noise-free L2 outputs [F_x … M_z] of 24 hovering-generator trajectories (seed 2021) from
 /// sample 100 on, with the vortex core r_c0 scaled by `core_scale`.
 fn l2_outputs_from_sample_100(core_scale: f64) -> Vec<[f64; 5]> {
     let mut wing = VirtualWingConfig {
@@ -717,10 +718,31 @@ fn l2_outputs_from_sample_100(core_scale: f64) -> Vec<[f64; 5]> {
     };
     wing.l2.ldvm.core_radius_frac *= core_scale;
     let ds = noise_free_dataset(wing, 24, 20, 2021);
+    from_sample_100(&ds)
+}
+
+fn from_sample_100(ds: &flapssm_wing::dataset::ValidDataset) -> Vec<[f64; 5]> {
     ds.trajectories
         .iter()
         .flat_map(|t| t.outputs.as_ref().unwrap()[100..].to_vec())
         .collect()
+}
+
+/// RMS change of each output between `base` and `nudged`, in standard deviations of `base`.
+fn change_in_sd(base: &[[f64; 5]], nudged: &[[f64; 5]]) -> [f64; 5] {
+    let n = base.len() as f64;
+    std::array::from_fn(|c| {
+        let mean = base.iter().map(|y| y[c]).sum::<f64>() / n;
+        let sd = (base.iter().map(|y| (y[c] - mean).powi(2)).sum::<f64>() / n).sqrt();
+        let rms = (base
+            .iter()
+            .zip(nudged)
+            .map(|(a, b)| (a[c] - b[c]).powi(2))
+            .sum::<f64>()
+            / n)
+            .sqrt();
+        rms / sd
+    })
 }
 
 /// The L2 data are a reproducible function of the kinematics: a 0.1 % change of the vortex
@@ -731,24 +753,116 @@ fn l2_outputs_from_sample_100(core_scale: f64) -> Vec<[f64; 5]> {
 /// (docs/vortex-method.md, round 9).
 #[test]
 fn l2_outputs_are_insensitive_to_a_small_parameter_change() {
-    let base = l2_outputs_from_sample_100(1.0);
-    let nudged = l2_outputs_from_sample_100(1.001);
-    let n = base.len() as f64;
-    let mut shares = [0.0; 5];
-    for (c, share) in shares.iter_mut().enumerate() {
-        let mean = base.iter().map(|y| y[c]).sum::<f64>() / n;
-        let sd = (base.iter().map(|y| (y[c] - mean).powi(2)).sum::<f64>() / n).sqrt();
-        let rms = (base
-            .iter()
-            .zip(&nudged)
-            .map(|(a, b)| (a[c] - b[c]).powi(2))
-            .sum::<f64>()
-            / n)
-            .sqrt();
-        *share = rms / sd;
-    }
+    let shares = change_in_sd(
+        &l2_outputs_from_sample_100(1.0),
+        &l2_outputs_from_sample_100(1.001),
+    );
     println!("rms change from r_c0 × 1.001, in σ of each output: {shares:.3?}");
     for (c, share) in shares.iter().enumerate() {
         assert!(*share < 0.25, "output {c}: {share:.3} σ");
+    }
+}
+
+/// The same 0.1 % core change on the measured-like default generator and on the paper's
+/// measured trajectories (24 each, noise-free L2), for the record (docs/vortex-method.md). A
+/// study, not a check: `cargo test --release -p flapssm-wing --test physics
+/// l2_sensitivity_study -- --ignored --nocapture`.
+#[test]
+#[ignore = "study: prints the L2 sensitivity on the default and the paper's kinematics"]
+fn l2_sensitivity_study() {
+    use flapssm_wing::sensor::SensorConfig;
+    use flapssm_wing::trajectories::paper::paper_angles;
+    use flapssm_wing::trajectories::{GeneratorConfig, SamplingConfig};
+    use flapssm_wing::virtual_wing::{SimulationConfig, simulate_angles_dataset, simulate_dataset};
+    let wing = |scale: f64| {
+        let mut w = VirtualWingConfig {
+            fidelity: Fidelity::L2,
+            sensor: SensorConfig::noise_free(),
+            ..Default::default()
+        };
+        w.l2.ldvm.core_radius_frac *= scale;
+        w
+    };
+    let generated = |scale| {
+        let cfg = SimulationConfig {
+            wing: wing(scale),
+            trajectories: GeneratorConfig {
+                n_trajectories: 24,
+                n_train: 20,
+                seed: 2021,
+                ..GeneratorConfig::default()
+            },
+        };
+        from_sample_100(&simulate_dataset(&cfg, &|| {}).unwrap())
+    };
+    let angles = paper_angles(24);
+    let paper = |scale| {
+        let ds = simulate_angles_dataset(
+            &wing(scale),
+            &angles,
+            &SamplingConfig::default(),
+            1,
+            20,
+            "paper 0..24",
+            &|| {},
+        );
+        from_sample_100(&ds.unwrap())
+    };
+    let d = change_in_sd(&generated(1.0), &generated(1.001));
+    println!("default generator: rms change from r_c0 × 1.001 (σ): {d:.3?}");
+    let p = change_in_sd(&paper(1.0), &paper(1.001));
+    println!("paper's trajectories: rms change from r_c0 × 1.001 (σ): {p:.3?}");
+}
+
+/// Trajectories whose raw (250 Hz, noise-free) L2 peak |F_x| exceeds 1.5× the L0 peak + 1 N
+/// (the burst criterion of docs/vortex-method.md), among the first 150 of the hovering
+/// generator, the default generator (seed 1, 548) and the paper's measured trajectories. A
+/// study, not a check: `cargo test --release -p flapssm-wing --test physics l2_burst_study --
+/// --ignored --nocapture`.
+#[test]
+#[ignore = "study: counts L2 bursts on three trajectory sets"]
+fn l2_burst_study() {
+    use flapssm_wing::trajectories::measured::raw_states;
+    use flapssm_wing::trajectories::paper::paper_angles;
+    use flapssm_wing::trajectories::{GeneratorConfig, SamplingConfig, default_n_train};
+    let sampling = SamplingConfig::default();
+    let dt = sampling.raw_dt_s();
+    let generated = |cfg: GeneratorConfig| -> Vec<Vec<EulerState>> {
+        let cfg = GeneratorConfig {
+            n_trajectories: 548,
+            n_train: default_n_train(548),
+            seed: 1,
+            ..cfg
+        };
+        let specs = cfg.generate().unwrap();
+        specs[..150]
+            .iter()
+            .map(|s| s.sample_raw(&sampling))
+            .collect()
+    };
+    let paper: Vec<Vec<EulerState>> = paper_angles(150)
+        .iter()
+        .map(|a| raw_states(a, &sampling).unwrap())
+        .collect();
+    for (name, set) in [
+        ("hovering", generated(GeneratorConfig::hovering())),
+        ("default", generated(GeneratorConfig::default())),
+        ("paper", paper),
+    ] {
+        let peak = |fidelity, states: &[EulerState]| {
+            let mut w = wing(fidelity);
+            let mut y = vec![[0.0; 5]; states.len()];
+            w.aero_loads_into(states, dt, &mut y);
+            y[250..].iter().map(|r| r[0].abs()).fold(0.0, f64::max)
+        };
+        let ratios: Vec<f64> = set
+            .iter()
+            .map(|s| peak(Fidelity::L2, s) / (1.5 * peak(Fidelity::L0, s) + 1.0))
+            .collect();
+        let bursts = ratios.iter().filter(|&&r| r > 1.0).count();
+        let worst = ratios.iter().copied().fold(0.0, f64::max);
+        println!(
+            "{name}: {bursts} of 150 with a burst; worst L2 peak / (1.5·L0 peak + 1 N) = {worst:.2}"
+        );
     }
 }

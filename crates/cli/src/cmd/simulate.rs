@@ -1,23 +1,36 @@
-//! `flapssm simulate`: run the virtual robotic wing on random trajectories and write a dataset.
+//! `flapssm simulate`: run the virtual robotic wing on the seeded generator's trajectories or on
+//! the paper's measured ones, and write a dataset.
 
 use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::Context;
-use clap::Args;
+use clap::{Args, ValueEnum};
 use flapssm_jobs::NoProgress;
-use flapssm_jobs::simulate::{SimulateSettings, simulate};
+use flapssm_jobs::simulate::{SimulateSettings, simulate, simulate_paper};
 use flapssm_wing::virtual_wing::Fidelity;
 
 use crate::progress::Bars;
 
-/// Simulate the robotic wing (aerodynamics + sensor chain) on random trajectories.
+/// Where the wing's trajectories come from.
+#[derive(Clone, Copy, ValueEnum)]
+enum Source {
+    /// The seeded random trajectory generator.
+    Generator,
+    /// The paper's 548 measured trajectories (Bayiz & Cheng 2021, vendored; the first N).
+    Paper,
+}
+
+/// Simulate the robotic wing (aerodynamics + sensor chain) on generated or measured trajectories.
 #[derive(Args)]
 pub struct SimulateArgs {
-    /// Number of trajectories.
+    /// Trajectories: the seeded generator, or the paper's measured set.
+    #[arg(long, value_enum, default_value = "generator")]
+    source: Source,
+    /// Number of trajectories (with --source paper: the first N of 548).
     #[arg(long, value_name = "N", default_value_t = 548)]
     n: usize,
-    /// Seed of the trajectories and of the sensor noise (same seed → identical file).
+    /// Seed of the generated trajectories and of the sensor noise (same seed → identical file).
     #[arg(long, value_name = "S", default_value_t = 0)]
     seed: u64,
     /// Aerodynamic fidelity: l0 (quasi-steady), l1 (unsteady low-order), l2 (vortex strips).
@@ -45,19 +58,20 @@ pub fn run(args: SimulateArgs) -> anyhow::Result<()> {
     let start = Instant::now();
     flapssm_jobs::files::check_outputs(&[&args.out], &[])?;
     let fidelity: Fidelity = args.fidelity.parse().context("parsing --fidelity")?;
-    let cfg = SimulateSettings {
+    let settings = SimulateSettings {
         n_trajectories: args.n,
         n_train: args.n_train,
         seed: args.seed,
         fidelity,
         noise_free: args.noise_free,
         flat: args.flat,
-    }
-    .check()?;
-    let ds = if args.quiet {
-        simulate(&cfg, None, &NoProgress)
-    } else {
-        simulate(&cfg, None, &Bars::new())
+    };
+    let cfg = settings.check()?;
+    let bars = Bars::new();
+    let progress: &dyn flapssm_jobs::Progress = if args.quiet { &NoProgress } else { &bars };
+    let ds = match args.source {
+        Source::Generator => simulate(&cfg, None, progress),
+        Source::Paper => simulate_paper(&settings, progress),
     }
     .context("simulating the wing")?;
     let sim_s = start.elapsed().as_secs_f64();
@@ -67,10 +81,14 @@ pub fn run(args: SimulateArgs) -> anyhow::Result<()> {
         .as_f64()
         .unwrap_or(f64::NAN);
     println!(
-        "wrote {}: {} trajectories ({} train) × {} samples, fidelity {:?}, {}, seed {}, mean Re {:.0}; \
+        "wrote {}: {} {} trajectories ({} train) × {} samples, fidelity {:?}, {}, seed {}, mean Re {:.0}; \
          simulated in {:.2} s, total {:.2} s",
         args.out.display(),
         ds.trajectories.len(),
+        match args.source {
+            Source::Generator => "generated",
+            Source::Paper => "measured (the paper's)",
+        },
         ds.n_train,
         cfg.trajectories.sampling.n_samples,
         fidelity,

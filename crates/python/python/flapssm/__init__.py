@@ -37,6 +37,7 @@ __all__ = [
     "Stream",
     "simulate",
     "simulate_angles",
+    "paper_angles",
     "trajectories",
     "kinematics",
     "sysid",
@@ -98,12 +99,19 @@ def simulate_angles(
     progress: Optional[Progress] = None,
 ) -> "_native.Dataset":
     """Simulates the virtual wing on given Euler angles ``(n, 470, 3)`` [φ, ψ, α] (rad) at
-    25 Hz — for example the paper's 548 measured trajectories
-    (``np.load("shared/data/bayiz2021-kinematics/euler_angles.npy")``): rates and
+    25 Hz — for example the paper's 548 measured trajectories (:func:`paper_angles`): rates and
     accelerations by a Savitzky–Golay fit, quintic Hermite interpolation to the wing's 250 Hz,
     then the aerodynamics and the sensor chain as in :func:`simulate`."""
     e = as_float_array("euler_rad", euler_rad, (None, 470, 3))
     return _native.simulate_angles(e, int(seed), fidelity, n_train, noise_free, progress)
+
+
+def paper_angles(n: Optional[int] = None) -> np.ndarray:
+    """The paper's measured trajectories (Bayiz & Cheng 2021; the first ``n``, default all 548,
+    the last 36 being the paper's test set) as Euler angles ``(n, 470, 3)`` [φ, ψ, α] (rad) at
+    25 Hz in flapssm's convention — the file's deviation and pitch negated (docs/kinematics.md).
+    ``simulate_angles(paper_angles())`` drives the virtual wing with them."""
+    return _native.paper_angles(n)
 
 
 def trajectories(n: int = 548, seed: int = 0, n_train: Optional[int] = None) -> "_native.Dataset":

@@ -101,12 +101,14 @@ pub struct Fluid {
 }
 
 impl Default for Fluid {
-    /// Mineral oil of the original experiment: ρ = 800 kg/m³, ν = 2.2e-5 m²/s (Re ≈ 1000 at
-    /// U_ref ≈ 0.37 m/s, c̄ = 0.06 m).
+    /// Mineral oil of the original experiment: ρ = 800 kg/m³ (the authors' code) and
+    /// ν = 1.05e-5 m²/s (10.5 cSt, μ = 8.4 mPa·s), from the paper's Re = U_ref c̄/ν ≈ 1000 with
+    /// the measured trajectories' U_ref (published recipe, R = 0.235 m: 0.1746 m/s, the same for
+    /// all 548 to ±0.5 %) and c̄ = 0.06 m: ν = 0.1746 · 0.06 / 1000.
     fn default() -> Self {
         Self {
             density_kg_m3: 800.0,
-            kinematic_viscosity_m2_s: 2.2e-5,
+            kinematic_viscosity_m2_s: 1.05e-5,
         }
     }
 }

@@ -119,7 +119,9 @@ impl Family {
 
 mod fourier;
 pub mod measured;
+pub mod paper;
 mod spec;
+pub mod stats;
 
 pub use fourier::FourierSeries;
 use fourier::smooth_square;
@@ -174,13 +176,43 @@ pub struct GeneratorConfig {
     pub seed: u64,
     /// Sampling.
     pub sampling: SamplingConfig,
-    /// Flapping frequency range (Hz). Default [0.2, 0.4].
+    /// Flapping frequency range (Hz). Without [`u_ref_m_s`](Self::u_ref_m_s) the frequency is
+    /// drawn uniformly from it; with it, the derived frequency must lie in it (else the draw is
+    /// repeated). Default [0.2, 0.4].
     pub frequency_hz: [f64; 2],
-    /// Stroke half-amplitude Φ range (deg). Default [40, 100].
+    /// Reference speed U_ref (m/s) every trajectory is given, as the robot's were (constant
+    /// Reynolds number): the frequency is U_ref / (R·L), L = ∮ √(φ′² + ψ′²) dx the tip path
+    /// per cycle at unit radius, R = [`U_REF_RADIUS_M`]. `None`: the frequency is drawn.
+    pub u_ref_m_s: Option<f64>,
+    /// Stroke half-amplitude Φ range (deg). Default [40, 89].
     pub stroke_amplitude_deg: [f64; 2],
+    /// Largest |stroke offset φ₀| (deg), within the servo room left by Φ. Default 0.
+    pub max_stroke_offset_deg: f64,
+    /// Largest |second-harmonic coefficient| of the stroke (relative to the first; sets the
+    /// asymmetry of the two half-strokes). Default 0.35.
+    pub stroke_second_harmonic: f64,
     /// Maximum deviation amplitude Ψ (deg). Default 40.
     pub max_deviation_deg: f64,
-    /// Conventional mid-stroke |AoA| range (deg). Default [20, 70].
+    /// Largest |deviation offset ψ₀| (deg). Default 0.
+    pub max_deviation_offset_deg: f64,
+    /// Deviation shaped to keep the leading edge leading: Ψ ≥ 8° (harmonic 5°), capped at 0.5Φ
+    /// (figure-eight, oval) or 0.3Φ (u-shaped), the tip rising through the reversals. Off
+    /// (default): Ψ uniform in [0, max] for every family and either orientation, as measured.
+    pub leading_edge_deviation: bool,
+    /// Pitch half-range range (deg): with it (default [10, 80]) the pitch's half-range and
+    /// offset ([`pitch_offset_deg`](Self::pitch_offset_deg)) are drawn uniformly, as the
+    /// measured set's are; `None`: the plateaus follow AoA targets ([`aoa_deg`](Self::aoa_deg),
+    /// [`p_aoa_near_zero`](Self::p_aoa_near_zero), [`p_aoa_reversed`](Self::p_aoa_reversed)).
+    pub pitch_half_range_deg: Option<[f64; 2]>,
+    /// Pitch offset range (deg; the mean of the two plateaus). Default [−30, 30].
+    pub pitch_offset_deg: [f64; 2],
+    /// Largest |phase| δ of the pitch against the stroke (cycles; advanced or delayed
+    /// rotation). Default 0.24, as measured (uniform over ±0.23 cycle).
+    pub max_pitch_phase_cycles: f64,
+    /// Highest odd harmonic of the pitch's smoothed square wave (1, 3, 5 or 7; the order is
+    /// drawn among the odd ones up to it). Default 5 (the measured peak pitch rates).
+    pub max_pitch_harmonic: usize,
+    /// Conventional mid-stroke |AoA| range (deg), with the AoA-target pitch. Default [20, 70].
     pub aoa_deg: [f64; 2],
     /// Probability that one half-stroke of a trajectory has |AoA| near zero (|AoA| ≤ 8°).
     pub p_aoa_near_zero: f64,
@@ -188,6 +220,9 @@ pub struct GeneratorConfig {
     pub p_aoa_reversed: f64,
     /// Ramp-in duration range (cycles). Default [1, 2].
     pub ramp_cycles: [f64; 2],
+    /// Longest ramp-in (s). Default 3.72 s, the 93 samples the published analyses skip, so that
+    /// the analysed part is in full motion, as the measured trajectories are. `None`: no limit.
+    pub max_ramp_s: Option<f64>,
     /// Servo limit on every |angle| (deg). Default 110.
     pub max_angle_deg: f64,
     /// Servo limit on every |rate| (deg/s). Default 900.
@@ -198,22 +233,61 @@ pub struct GeneratorConfig {
 }
 
 impl Default for GeneratorConfig {
+    /// Calibrated to the paper's 548 measured trajectories (see `docs/kinematics.md`): every
+    /// trajectory at U_ref = 0.1746 m/s (their constant Reynolds number), Φ 40–89°, Ψ 0–40°,
+    /// pitch half-range 10–80° and offset ±30°, no stroke or deviation offset, and the family
+    /// mix of the measured tip paths (figure-eight 21 %, u-shaped 15 %, oval 37 %, flat 8 %,
+    /// mixed harmonics 19 %).
     fn default() -> Self {
         Self {
             n_trajectories: 548,
             n_train: 512,
             seed: 0,
             sampling: SamplingConfig::default(),
-            frequency_hz: [0.2, 0.4],
-            stroke_amplitude_deg: [40.0, 100.0],
+            frequency_hz: [0.1, 0.3],
+            u_ref_m_s: Some(0.1746),
+            stroke_amplitude_deg: [40.0, 89.0],
+            max_stroke_offset_deg: 0.0,
+            stroke_second_harmonic: 0.05,
             max_deviation_deg: 40.0,
+            max_deviation_offset_deg: 0.0,
+            leading_edge_deviation: false,
+            pitch_half_range_deg: Some([10.0, 80.0]),
+            pitch_offset_deg: [-30.0, 30.0],
+            max_pitch_phase_cycles: 0.24,
+            max_pitch_harmonic: 5,
             aoa_deg: [20.0, 70.0],
             p_aoa_near_zero: 0.1,
             p_aoa_reversed: 0.1,
             ramp_cycles: [1.0, 2.0],
+            max_ramp_s: Some(3.72),
             max_angle_deg: 110.0,
             max_rate_deg_s: 900.0,
+            family_weights: [0.21, 0.15, 0.37, 0.08, 0.19],
+        }
+    }
+}
+
+impl GeneratorConfig {
+    /// Hovering-like kinematics, the generator before its calibration to the measured set:
+    /// 0.2–0.4 Hz drawn freely, Φ 40–100°, offsets up to 15° (stroke) and 10° (deviation),
+    /// the leading edge kept leading by the deviation's shape and by AoA targets (|AoA| 20–70°,
+    /// 10 % near-zero and 10 % reversed half-strokes).
+    pub fn hovering() -> Self {
+        Self {
+            frequency_hz: [0.2, 0.4],
+            u_ref_m_s: None,
+            stroke_amplitude_deg: [40.0, 100.0],
+            max_stroke_offset_deg: 15.0,
+            stroke_second_harmonic: 0.05,
+            max_deviation_offset_deg: 10.0,
+            leading_edge_deviation: true,
+            pitch_half_range_deg: None,
+            max_pitch_phase_cycles: 0.08,
+            max_pitch_harmonic: 7,
+            max_ramp_s: None,
             family_weights: [0.3, 0.2, 0.2, 0.15, 0.15],
+            ..Self::default()
         }
     }
 }
@@ -289,6 +363,14 @@ impl GeneratorConfig {
             1e-3,
             0.25 / self.sampling.dataset_dt_s(),
         )?;
+        let duration_s = (s.n_samples - 1) as f64 * s.dataset_dt_s();
+        if self.frequency_hz[0] * duration_s < 1.25 {
+            return bad(
+                "frequency_hz",
+                self.frequency_hz[0],
+                "gives fewer than the 1.25 cycles per trajectory that the published U_ref needs",
+            );
+        }
         check_range(
             "stroke_amplitude_deg",
             self.stroke_amplitude_deg,
@@ -296,7 +378,42 @@ impl GeneratorConfig {
             0.95 * self.max_angle_deg,
         )?;
         check_range("aoa_deg", self.aoa_deg, 0.0, 89.0)?;
+        if let Some(r) = self.pitch_half_range_deg {
+            check_range("pitch_half_range_deg", r, 0.0, 0.95 * self.max_angle_deg)?;
+        }
+        check_range("pitch_offset_deg", self.pitch_offset_deg, -90.0, 90.0)?;
+        if ![1, 3, 5, 7].contains(&self.max_pitch_harmonic) {
+            return bad(
+                "max_pitch_harmonic",
+                self.max_pitch_harmonic as f64,
+                "must be 1, 3, 5 or 7",
+            );
+        }
+        for (field, v, hi) in [
+            ("max_stroke_offset_deg", self.max_stroke_offset_deg, 90.0),
+            ("stroke_second_harmonic", self.stroke_second_harmonic, 1.0),
+            (
+                "max_deviation_offset_deg",
+                self.max_deviation_offset_deg,
+                45.0,
+            ),
+            ("max_pitch_phase_cycles", self.max_pitch_phase_cycles, 0.5),
+        ] {
+            if !(v.is_finite() && (0.0..=hi).contains(&v)) {
+                return bad(field, v, "out of range");
+            }
+        }
+        if let Some(u) = self.u_ref_m_s
+            && !(u.is_finite() && u > 0.0)
+        {
+            return bad("u_ref_m_s", u, "must be positive");
+        }
         check_range("ramp_cycles", self.ramp_cycles, 0.0, 10.0)?;
+        if let Some(r) = self.max_ramp_s
+            && !(r.is_finite() && r >= 0.0)
+        {
+            return bad("max_ramp_s", r, "must be non-negative");
+        }
         if !(self.max_deviation_deg >= 0.0 && self.max_deviation_deg <= 0.8 * self.max_angle_deg) {
             return bad(
                 "max_deviation_deg",
@@ -433,6 +550,29 @@ impl GeneratorConfig {
         })
     }
 
+    /// Signed AoA targets of the two half-strokes (rad): conventional AoA·φ̇ < 0, i.e. −|AoA|
+    /// for φ̇ > 0 and +|AoA| for φ̇ < 0; one half-stroke near zero or reversed with the
+    /// configured probabilities.
+    fn aoa_targets(&self, rng: &mut ChaCha8Rng) -> [f64; 2] {
+        let u = |rng: &mut ChaCha8Rng, r: [f64; 2]| {
+            if r[1] > r[0] {
+                rng.random_range(r[0]..r[1])
+            } else {
+                r[0]
+            }
+        };
+        let mut targets = [-u(rng, self.aoa_deg) * DEG, u(rng, self.aoa_deg) * DEG];
+        let which = rng.random_range(0..2usize);
+        let sign = if which == 0 { -1.0 } else { 1.0 };
+        let p: f64 = rng.random();
+        if p < self.p_aoa_near_zero {
+            targets[which] = sign * rng.random_range(-3.0..8.0) * DEG;
+        } else if p < self.p_aoa_near_zero + self.p_aoa_reversed {
+            targets[which] = -sign * rng.random_range(8.0..20.0) * DEG;
+        }
+        targets
+    }
+
     fn draw(&self, rng: &mut ChaCha8Rng, family: Family) -> Option<TrajectorySpec> {
         let u = |rng: &mut ChaCha8Rng, r: [f64; 2]| {
             if r[1] > r[0] {
@@ -441,8 +581,8 @@ impl GeneratorConfig {
                 r[0]
             }
         };
-        let f = u(rng, self.frequency_hz);
-        let ramp_s = u(rng, self.ramp_cycles) / f;
+        let drawn_f = u(rng, self.frequency_hz);
+        let ramp_cycles = u(rng, self.ramp_cycles);
         let amp = u(rng, self.stroke_amplitude_deg) * DEG;
         let max_dev = self.max_deviation_deg * DEG;
 
@@ -450,7 +590,8 @@ impl GeneratorConfig {
         let mut stroke = FourierSeries::default();
         stroke.add_sin(1, 1.0, 0.0);
         stroke.add_sin(3, rng.random_range(-0.1..0.03), 0.0);
-        stroke.add_sin(2, rng.random_range(-0.05..0.05), rng.random_range(-PI..PI));
+        let h2 = self.stroke_second_harmonic;
+        stroke.add_sin(2, u(rng, [-h2, h2]), rng.random_range(-PI..PI));
         if family == Family::Harmonic {
             for k in 2..=4 {
                 stroke.add_sin(
@@ -462,37 +603,54 @@ impl GeneratorConfig {
         }
         let mut stroke = stroke.scaled(amp / stroke.half_range());
         let room = (self.max_angle_deg * DEG - amp).max(0.0);
-        stroke.offset_rad = rng.random_range(-1.0..1.0) * room.min(15.0 * DEG);
+        stroke.offset_rad =
+            rng.random_range(-1.0..1.0) * room.min(self.max_stroke_offset_deg * DEG);
 
         let mut dev = FourierSeries::default();
-        let dev_amp = |rng: &mut ChaCha8Rng, lo: f64| rng.random_range(lo.min(max_dev)..=max_dev);
+        let guard = self.leading_edge_deviation;
+        // Ψ from [lo, max] (or [0, max] without the leading-edge guard), capped at `cap`·Φ.
+        let dev_amp = |rng: &mut ChaCha8Rng, lo: f64, cap: f64| {
+            if guard {
+                rng.random_range(lo.min(max_dev)..=max_dev).min(cap * amp)
+            } else {
+                rng.random_range(0.0..=max_dev)
+            }
+        };
+        // Orientation of the tip path: fixed with the guard, either way as measured.
+        let orientation = |rng: &mut ChaCha8Rng| {
+            if guard || rng.random::<bool>() {
+                1.0
+            } else {
+                -1.0
+            }
+        };
         match family {
             Family::FigureEight => {
-                // Tip rises through both reversals (ψ̇ > 0 while the pitch flips through α = 0,
-                // leading edge up), so the leading edge keeps leading.
-                let a = dev_amp(rng, 8.0 * DEG).min(0.5 * amp);
+                // Guarded: the tip rises through both reversals (ψ̇ > 0 while the pitch flips
+                // through α = 0, leading edge up), so the leading edge keeps leading.
+                let a = dev_amp(rng, 8.0 * DEG, 0.5) * orientation(rng);
                 dev.add_sin(2, -a, rng.random_range(-0.5..0.5));
             }
             Family::UShaped => {
-                // Ψ ≤ 0.3Φ keeps the descent after the reversal shallower than ~30°, which the
-                // pitch rotation can follow with the leading edge first.
-                let a = dev_amp(rng, 8.0 * DEG).min(0.3 * amp);
-                // Highest point at or just after the reversal: ψ̇ ≥ 0 during the flip.
+                // Guarded: Ψ ≤ 0.3Φ keeps the descent after the reversal shallower than ~30°,
+                // which the pitch rotation can follow with the leading edge first, and the
+                // highest point is at or just after the reversal (ψ̇ ≥ 0 during the flip).
+                let a = dev_amp(rng, 8.0 * DEG, 0.3) * orientation(rng);
                 dev.add_cos(2, -a, rng.random_range(-0.4..0.0));
             }
             Family::Oval => {
-                let a = dev_amp(rng, 8.0 * DEG).min(0.5 * amp);
+                let a = dev_amp(rng, 8.0 * DEG, 0.5);
                 dev.add_cos(1, a, rng.random_range(-0.6..0.6));
             }
             Family::Flat => {
                 dev.add_sin(
                     1,
-                    dev_amp(rng, 0.0).min(3.0 * DEG),
+                    rng.random_range(0.0..=max_dev).min(3.0 * DEG),
                     rng.random_range(-PI..PI),
                 );
             }
             Family::Harmonic => {
-                let total = dev_amp(rng, 5.0 * DEG);
+                let total = dev_amp(rng, 5.0 * DEG, f64::INFINITY);
                 let mut weights = [0.0; 3];
                 for (k, wk) in weights.iter_mut().enumerate() {
                     *wk = rng.random_range(0.0..1.0) / (k + 1) as f64;
@@ -505,22 +663,18 @@ impl GeneratorConfig {
             }
         }
         if family != Family::Flat {
-            dev.offset_rad = rng.random_range(-10.0..10.0) * DEG;
+            let o = self.max_deviation_offset_deg;
+            dev.offset_rad = u(rng, [-o, o]) * DEG;
         }
 
-        // Signed AoA targets: conventional AoA·φ̇ < 0, i.e. −|AoA| for φ̇ > 0, +|AoA| for φ̇ < 0.
-        let mut targets = [-u(rng, self.aoa_deg) * DEG, u(rng, self.aoa_deg) * DEG];
-        let which = rng.random_range(0..2usize);
-        let sign = if which == 0 { -1.0 } else { 1.0 };
-        let p: f64 = rng.random();
-        if p < self.p_aoa_near_zero {
-            targets[which] = sign * rng.random_range(-3.0..8.0) * DEG;
-        } else if p < self.p_aoa_near_zero + self.p_aoa_reversed {
-            targets[which] = -sign * rng.random_range(8.0..20.0) * DEG;
-        }
-
-        // Pitch plateaus from AoA(α) = AoA(α = 0) − α at the plateau centres x = −δ, π − δ.
-        let delta = rng.random_range(-0.08..0.08) * 2.0 * PI;
+        let drawn_pitch = match self.pitch_half_range_deg {
+            Some(range) => {
+                PitchDraw::HalfRangeOffset(u(rng, range) * DEG, u(rng, self.pitch_offset_deg) * DEG)
+            }
+            None => PitchDraw::AoaTargets(self.aoa_targets(rng)),
+        };
+        let phase = self.max_pitch_phase_cycles;
+        let delta = u(rng, [-phase, phase]) * 2.0 * PI;
         let aoa_flat = |x: f64| {
             let [p0, p1, _] = stroke.eval(x);
             let [d0, d1, _] = dev.eval(x);
@@ -532,13 +686,29 @@ impl GeneratorConfig {
             WingKinematics::from_euler(&st).aoa_rad
         };
         let wrap = |a: f64| (a + PI).rem_euclid(2.0 * PI) - PI;
-        let alpha_pos = wrap(aoa_flat(-delta) - targets[0]);
-        let alpha_neg = wrap(aoa_flat(PI - delta) - targets[1]);
-        let (a1, a2) = (-alpha_pos, alpha_neg);
-        let k_max = [1, 3, 5, 7][rng.random_range(0..4usize)];
+        // Plateaus −A₁ (φ̇ > 0, centre x = −δ) and A₂ (φ̇ < 0, centre x = π − δ), and the
+        // signed AoA there: AoA(α) = AoA(α = 0) − α.
+        let (a1, a2, targets) = match drawn_pitch {
+            PitchDraw::HalfRangeOffset(half, offset) => {
+                let (a1, a2) = (half - offset, half + offset);
+                let targets = [wrap(aoa_flat(-delta) + a1), wrap(aoa_flat(PI - delta) - a2)];
+                (a1, a2, targets)
+            }
+            PitchDraw::AoaTargets(targets) => (
+                -wrap(aoa_flat(-delta) - targets[0]),
+                wrap(aoa_flat(PI - delta) - targets[1]),
+                targets,
+            ),
+        };
+        let k_max = [1, 3, 5, 7][rng.random_range(0..self.max_pitch_harmonic.div_ceil(2))];
         let sq = smooth_square(k_max).shifted(delta);
         let mut pitch = sq.scaled(-0.5 * (a1 + a2));
-        pitch.add(&sq.product(&sq).scaled(-0.5 * (a1 - a2)));
+        match drawn_pitch {
+            // The measured law: a constant offset, the mean of the two plateaus.
+            PitchDraw::HalfRangeOffset(..) => pitch.offset_rad = -0.5 * (a1 - a2),
+            // α = 0 at the flips (S = 0), the plateaus set by S² = 1.
+            PitchDraw::AoaTargets(_) => pitch.add(&sq.product(&sq).scaled(-0.5 * (a1 - a2))),
+        }
         if family == Family::Harmonic {
             // Perturbation vanishing at both plateau centres keeps the AoA targets exact.
             let mut bump = FourierSeries::default();
@@ -548,9 +718,20 @@ impl GeneratorConfig {
             wobble.add_cos(2, 0.5, rng.random_range(-PI..PI));
             pitch.add(&bump.product(&wobble));
         }
-        if !(alpha_pos.is_finite() && alpha_neg.is_finite()) {
+        if !(a1.is_finite() && a2.is_finite()) {
             return None;
         }
+        let f = match self.u_ref_m_s {
+            None => drawn_f,
+            Some(u_ref) => {
+                let f = u_ref / (U_REF_RADIUS_M * path_per_cycle(&stroke, &dev));
+                if !(self.frequency_hz[0]..=self.frequency_hz[1]).contains(&f) {
+                    return None;
+                }
+                f
+            }
+        };
+        let ramp_s = (ramp_cycles / f).min(self.max_ramp_s.unwrap_or(f64::INFINITY));
         let t_end = (self.sampling.n_samples - 1) as f64 * self.sampling.dataset_dt_s();
         let phase_rad = (-2.0 * PI * f * t_end).rem_euclid(2.0 * PI);
         Some(TrajectorySpec {
@@ -562,6 +743,27 @@ impl GeneratorConfig {
             aoa_targets_rad: targets,
         })
     }
+}
+
+/// The pitch drawn for one trajectory, before its plateaus are placed.
+enum PitchDraw {
+    /// Half-range and offset (rad).
+    HalfRangeOffset(f64, f64),
+    /// Signed AoA targets of the two half-strokes (rad).
+    AoaTargets([f64; 2]),
+}
+
+/// The tip path per cycle at unit radius, L = ∮ √(φ′(x)² + ψ′(x)²) dx (rad; ′ = d/dx), by the
+/// midpoint rule on [`BOUND_GRID`] points (exact to rounding for these trigonometric series).
+fn path_per_cycle(stroke: &FourierSeries, dev: &FourierSeries) -> f64 {
+    let h = 2.0 * PI / BOUND_GRID as f64;
+    (0..BOUND_GRID)
+        .map(|i| {
+            let x = (i as f64 + 0.5) * h;
+            stroke.eval(x)[1].hypot(dev.eval(x)[1])
+        })
+        .sum::<f64>()
+        * h
 }
 
 /// Kinematics-only dataset: analytic inputs at the dataset rate, `outputs = None`, U_ref as
@@ -703,8 +905,17 @@ mod tests {
         let seq = cfg.family_sequence();
         assert_eq!(seq.len(), 548);
         let count = |f| seq.iter().filter(|&&g| g == f).count();
-        assert_eq!(count(Family::FigureEight), 164); // 0.3 · 548 = 164.4
-        assert_eq!(count(Family::Flat), 82); // 0.15 · 548 = 82.2
+        assert_eq!(count(Family::FigureEight), 115); // 0.21 · 548 = 115.08
+        assert_eq!(count(Family::Oval), 203); // 0.37 · 548 = 202.76, a largest remainder
+        assert_eq!(count(Family::Flat), 44); // 0.08 · 548 = 43.84, the largest remainder
+        let hovering = GeneratorConfig::hovering().family_sequence();
+        assert_eq!(
+            hovering
+                .iter()
+                .filter(|&&g| g == Family::FigureEight)
+                .count(),
+            164
+        );
         let small = GeneratorConfig {
             n_trajectories: 5,
             n_train: 4,
