@@ -5,7 +5,7 @@ mod common;
 
 use std::path::{Path, PathBuf};
 
-use common::flapssm;
+use common::{flapssm, json, ok, s};
 
 use flapssm_data::npz::NpzReader;
 use flapssm_wing::dataset::{Dataset, DatasetMeta, Trajectory, ValidDataset};
@@ -185,6 +185,7 @@ fn fit_and_predict_a_dataset() {
         model.to_str().unwrap(),
         "--rule",
         "min",
+        "--predict-intercept",
     ]);
     assert!(
         out.status.success(),
@@ -229,6 +230,7 @@ fn fit_and_predict_a_dataset() {
         );
     }
 
+    assert_eq!(r.f64("intercept").unwrap().data, vec![1.0]);
     // Published mode drops the intercept: the outputs' offsets are then missing.
     let pred2 = dir.path().join("pred2.npz");
     let out = flapssm(&[
@@ -243,6 +245,48 @@ fn fit_and_predict_a_dataset() {
     assert!(out.status.success());
     let mut r2 = NpzReader::open(&pred2).unwrap();
     assert_eq!(r2.f64("intercept").unwrap().data, vec![0.0]);
+    let offset_missing = r2.f64_shaped("rmse_test", &[5]).unwrap();
+    assert!(
+        offset_missing.iter().all(|v| v / noise_std > 1.5),
+        "{offset_missing:?}"
+    );
+
+    // By default a model predicts as published (intercept dropped) and its folds are random
+    // (seed 0); `--contiguous` keeps whole trajectories in a fold. Each choice is recorded.
+    let published = dir.path().join("published.json");
+    ok(&[
+        "qs",
+        "fit",
+        s(&ds_path),
+        "--out",
+        s(&published),
+        "--rule",
+        "min",
+    ]);
+    let m = json(&published);
+    assert_eq!(m["prediction_intercept"], "dropped");
+    assert_eq!(m["options"]["folds"]["kind"], "random");
+    assert_eq!(m["options"]["folds"]["seed"], 0);
+    let pred3 = dir.path().join("pred3.npz");
+    let text = ok(&[
+        "qs",
+        "predict",
+        s(&published),
+        s(&ds_path),
+        "--out",
+        s(&pred3),
+    ]);
+    assert!(text.contains("intercept dropped"), "{text}");
+    let contiguous = dir.path().join("contiguous.json");
+    ok(&[
+        "qs",
+        "fit",
+        s(&ds_path),
+        "--out",
+        s(&contiguous),
+        "--contiguous",
+    ]);
+    assert_eq!(json(&contiguous)["options"]["folds"]["kind"], "contiguous");
 }
 
 fn fails_with(args: &[&str], needles: &[&str]) {

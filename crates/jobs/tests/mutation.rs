@@ -73,6 +73,7 @@ fn fixtures(dir: &Path) -> Vec<(&'static str, PathBuf, Reader)> {
 
     let lq = LrqsmFit {
         features: FeatureSet::Published,
+        prediction_intercept: Default::default(),
         options: EnetOptions {
             n_lambdas: 5,
             n_folds: 2,

@@ -53,6 +53,7 @@ impl Lrqsm {
         let fit = LrqsmFit {
             features,
             options,
+            prediction_intercept: Default::default(),
             source: "python".into(),
         };
         let model = py

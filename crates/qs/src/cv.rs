@@ -33,19 +33,26 @@ use crate::enet::{CdWorkspace, Convergence, lambda_grid, lambda_max, solve_path}
 use crate::error::QsError;
 
 /// How rows are assigned to the K folds.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case", tag = "kind")]
 pub enum FoldLayout {
     /// Contiguous blocks in row order, sizes as `np.array_split(range(n), K)`: the first
     /// n mod K folds hold ⌈n/K⌉ rows, the others ⌊n/K⌋. For trajectory-major data this keeps
     /// trajectories (nearly) whole within a fold.
-    #[default]
     Contiguous,
-    /// A seeded random permutation of the rows (ChaCha8), then split as above.
+    /// A seeded random permutation of the rows (ChaCha8), then split as above: rows of one
+    /// trajectory fall in every fold, as MATLAB's `lasso(…, 'CV', K)` partitions them
+    /// (the published baseline; [`Default`]: seed 0).
     Random {
         /// Seed of the permutation.
         seed: u64,
     },
+}
+
+impl Default for FoldLayout {
+    fn default() -> Self {
+        Self::Random { seed: 0 }
+    }
 }
 
 /// Which λ of the path to keep.
@@ -96,7 +103,7 @@ impl Default for EnetOptions {
             standardize: true,
             intercept: true,
             n_folds: 10,
-            folds: FoldLayout::Contiguous,
+            folds: FoldLayout::default(),
             rule: LambdaRule::OneSe,
             tol: 1e-10,
             max_sweeps: 100_000,

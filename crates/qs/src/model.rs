@@ -46,13 +46,22 @@ pub struct ChosenFit {
 }
 
 /// Whether prediction adds the fitted intercept.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
 pub enum InterceptMode {
-    /// ŷ = b₀ + xᵀb (default).
-    #[default]
+    /// ŷ = b₀ + xᵀb.
     Fitted,
-    /// ŷ = xᵀb, as the published `y = x*LRmodel` (harmless only for near-zero-mean targets).
+    /// ŷ = xᵀb, as the published `y = x*LRmodel`: MATLAB's `lasso` centres the data and returns
+    /// an intercept, which the published code does not add (the default, the published
+    /// baseline).
+    #[default]
     Dropped,
+}
+
+/// Model files written before [`LrqsmModel::prediction_intercept`] existed predicted with the
+/// intercept.
+fn fitted() -> InterceptMode {
+    InterceptMode::Fitted
 }
 
 /// A fitted linear-regression quasi-steady model (LRQSM).
@@ -70,6 +79,9 @@ pub struct LrqsmModel {
     pub source: String,
     /// Options of the fit.
     pub options: EnetOptions,
+    /// Whether the model's predictions add the fitted intercept (default dropped, as published).
+    #[serde(default = "fitted")]
+    pub prediction_intercept: InterceptMode,
     /// Chosen model per output.
     pub chosen: Vec<ChosenFit>,
     /// Paths, CV curves and standardization.
@@ -104,6 +116,7 @@ impl LrqsmModel {
             target_scaling,
             source: source.into(),
             options,
+            prediction_intercept: InterceptMode::default(),
             chosen,
             fit,
         }
@@ -120,7 +133,8 @@ impl LrqsmModel {
     }
 
     /// Predicts every output for one feature row (length p) into `out` (length m), on the
-    /// fitted-target scale.
+    /// fitted-target scale, adding the intercept as `mode` says (the model's own choice is
+    /// [`prediction_intercept`](Self::prediction_intercept)).
     pub fn predict_row(&self, features: &[f64], mode: InterceptMode, out: &mut [f64]) {
         for (o, c) in out.iter_mut().zip(&self.chosen) {
             let lin: f64 = c.coef.iter().zip(features).map(|(b, x)| b * x).sum();

@@ -278,6 +278,15 @@ fn model_file_round_trip_and_validation() {
     m.predict_row(&row, InterceptMode::Dropped, &mut out);
     assert!((out[1] - lin).abs() < 1e-12);
 
+    // The published baseline by default: random folds (seed 0), intercept not added; a file
+    // written before `prediction_intercept` existed predicted with the intercept and still does.
+    assert_eq!(EnetOptions::default().folds, FoldLayout::Random { seed: 0 });
+    assert_eq!(m.prediction_intercept, InterceptMode::Dropped);
+    let mut old: serde_json::Value = serde_json::to_value(&m).unwrap();
+    old.as_object_mut().unwrap().remove("prediction_intercept");
+    let old = LrqsmModel::from_json(&old.to_string(), &path).unwrap();
+    assert_eq!(old.prediction_intercept, InterceptMode::Fitted);
+
     let mut v: serde_json::Value = serde_json::to_value(&m).unwrap();
     v["format_version"] = (MODEL_FORMAT_VERSION + 1).into();
     let e = LrqsmModel::from_json(&v.to_string(), &path).unwrap_err();

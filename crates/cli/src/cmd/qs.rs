@@ -55,9 +55,13 @@ pub struct PathArgs {
     /// λ selection rule.
     #[arg(long, value_enum, default_value = "1se")]
     rule: Rule,
-    /// Use seeded random folds instead of contiguous blocks of rows.
+    /// Seed of the random fold partition of the rows (default 0; the published baseline's
+    /// layout, as MATLAB's `lasso(…, 'CV', K)`).
     #[arg(long, value_name = "SEED")]
     random_folds: Option<u64>,
+    /// Contiguous blocks of rows as folds instead (whole trajectories, up to the boundaries).
+    #[arg(long, conflicts_with = "random_folds")]
+    contiguous: bool,
     /// Number of λ on the path.
     #[arg(long, default_value_t = 100)]
     n_lambdas: usize,
@@ -80,9 +84,13 @@ impl PathArgs {
                 Rule::OneSe => LambdaRule::OneSe,
                 Rule::Min => LambdaRule::Min,
             },
-            folds: self
-                .random_folds
-                .map_or(FoldLayout::Contiguous, |seed| FoldLayout::Random { seed }),
+            folds: if self.contiguous {
+                FoldLayout::Contiguous
+            } else {
+                FoldLayout::Random {
+                    seed: self.random_folds.unwrap_or(0),
+                }
+            },
             ..EnetOptions::default()
         }
     }
@@ -99,6 +107,9 @@ pub struct FitArgs {
     /// Feature set.
     #[arg(long, value_enum, default_value = "published")]
     features: Features,
+    /// Predict with the fitted intercept (default: dropped, as the published `y = x*LRmodel`).
+    #[arg(long)]
+    predict_intercept: bool,
     #[command(flatten)]
     path: PathArgs,
 }
@@ -113,7 +124,8 @@ pub struct PredictArgs {
     /// Predictions file to write (.npz).
     #[arg(long)]
     out: PathBuf,
-    /// Drop the intercept, as the published `y = x*LRmodel`.
+    /// Drop the intercept whatever the model file says (models predict as they were fitted:
+    /// without it by default, as the published `y = x*LRmodel`).
     #[arg(long)]
     published: bool,
 }
@@ -144,9 +156,6 @@ pub struct FitCsvArgs {
     /// Fit without intercept (nothing is centred).
     #[arg(long)]
     no_intercept: bool,
-    /// Contiguous folds in row order (default; exclusive with --random-folds).
-    #[arg(long, conflicts_with = "random_folds")]
-    contiguous: bool,
     #[command(flatten)]
     path: PathArgs,
 }
@@ -173,6 +182,11 @@ fn fit(a: FitArgs) -> Result<()> {
             Features::PaperText => FeatureSet::PaperText,
         },
         options: a.path.options(),
+        prediction_intercept: if a.predict_intercept {
+            InterceptMode::Fitted
+        } else {
+            InterceptMode::Dropped
+        },
         source: a.dataset.display().to_string(),
     };
     let model = fit
@@ -267,7 +281,7 @@ fn predict(a: PredictArgs) -> Result<()> {
     let mode = if a.published {
         InterceptMode::Dropped
     } else {
-        InterceptMode::Fitted
+        model.prediction_intercept
     };
     let pred = predict_file(&model, &ds, mode, &a.out).with_context(|| {
         format!(
@@ -297,10 +311,10 @@ fn predict(a: PredictArgs) -> Result<()> {
         a.out.display(),
         pred.n_trajectories,
         pred.n_samples,
-        if a.published {
+        if mode == InterceptMode::Dropped {
             ", intercept dropped"
         } else {
-            ""
+            ", intercept added"
         }
     );
     Ok(())

@@ -800,7 +800,6 @@ mod tests {
     use crate::progress::NoProgress;
     use crate::test_data::tiny_dataset;
     use crate::train::{TrainingOptions, train_prssm};
-    use flapssm_qs::InterceptMode;
 
     /// The pipeline's LRQSM errors agree with the qs crate's own RMSE (computed there from raw
     /// loads divided by σ), and its sums are consistent: overall² = mean of per-output RMSE²,
@@ -811,7 +810,8 @@ mod tests {
         let lrqsm =
             flapssm_qs::lrqsm::fit_dataset(&ds, Default::default(), &Default::default(), "tiny")
                 .unwrap();
-        let q = flapssm_qs::lrqsm::predict_dataset(&lrqsm, &ds, InterceptMode::Fitted).unwrap();
+        let q =
+            flapssm_qs::lrqsm::predict_dataset(&lrqsm, &ds, lrqsm.prediction_intercept).unwrap();
         let opts = TrainingOptions {
             dx: Some(5),
             inducing: Some(6),

@@ -96,7 +96,8 @@ impl LoadModel for LrqsmLoadModel<'_> {
             .chunks_exact(self.features.len())
             .zip(out.mean.chunks_exact_mut(5))
         {
-            self.model.predict_row(row, InterceptMode::Fitted, &mut z);
+            self.model
+                .predict_row(row, self.model.prediction_intercept, &mut z);
             for t in 0..5 {
                 y[t] = scaling.mean[t] + scaling.std[t] * z[t];
             }
@@ -129,6 +130,8 @@ pub struct LrqsmFit {
     pub features: FeatureSet,
     /// Elastic-net path and cross-validation options.
     pub options: EnetOptions,
+    /// Whether the model's predictions add the fitted intercept (published: dropped).
+    pub prediction_intercept: InterceptMode,
     /// Where the data came from (recorded in the model).
     pub source: String,
 }
@@ -138,7 +141,8 @@ impl Fit for LrqsmFit {
 
     fn fit(&self, ds: &ValidDataset, progress: &dyn Progress) -> Result<Self::Model> {
         progress.start("fit LRQSM", 0);
-        let m = fit_dataset(ds, self.features, &self.options, &self.source)?;
+        let mut m = fit_dataset(ds, self.features, &self.options, &self.source)?;
+        m.prediction_intercept = self.prediction_intercept;
         progress.finish("");
         LrqsmLoadModel::from_cow(Cow::Owned(m))
     }
