@@ -6,7 +6,7 @@ use std::sync::atomic::AtomicBool;
 
 use flapssm_prssm::SequenceView;
 use flapssm_prssm::train::fit::{FitError, FitOutcome, FitSpec, Preset, fit};
-use flapssm_prssm::train::{Budget, Checkpoint, LrSchedule, TrainEvent, TrainHooks};
+use flapssm_prssm::train::{BestBy, Budget, Checkpoint, LrSchedule, TrainEvent, TrainHooks};
 use flapssm_wing::dataset::{Trajectory, ValidDataset};
 use serde::{Deserialize, Serialize};
 
@@ -41,6 +41,10 @@ pub struct TrainingOptions {
     pub seed: u64,
     /// Fraction of the training trajectories (the last ones) held out for best-model selection.
     pub val_fraction: f64,
+    /// How the best model is chosen: by RMSE (validation, else training rollouts) or, as the
+    /// published code, by the lowest epoch-mean training loss.
+    #[serde(default)]
+    pub best_by: BestBy,
     /// Checkpoint every this many epochs (0: only when interrupted).
     pub checkpoint_every: u64,
 }
@@ -61,6 +65,7 @@ impl Default for TrainingOptions {
             eval_every: None,
             seed: 0,
             val_fraction: 0.1,
+            best_by: BestBy::Rmse,
             checkpoint_every: 10,
         }
     }
@@ -100,6 +105,7 @@ impl TrainingOptions {
         }
         spec.train.seed = self.seed;
         spec.train.checkpoint_every = self.checkpoint_every;
+        spec.train.best_by = self.best_by;
         spec
     }
 

@@ -7,7 +7,7 @@ use std::cell::RefCell;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use flapssm_prssm::train::{
-    Budget, Checkpoint, DivergenceGuard, Evaluation, LrSchedule, TrainConfig, TrainError,
+    BestBy, Budget, Checkpoint, DivergenceGuard, Evaluation, LrSchedule, TrainConfig, TrainError,
     TrainEvent, TrainHooks, WindowSpec, train,
 };
 use flapssm_prssm::{Objective, ObjectiveError, Window};
@@ -584,4 +584,58 @@ fn best_model_is_the_lowest_validation_error_and_lr_follows_the_schedule() {
     assert_eq!(eval_fn(&best.params).unwrap().val_rmse, Some(best_val));
     // The validation target is off the optimum, so the best is not the last epoch.
     assert_ne!(best_epoch, 29);
+}
+
+/// `BestBy::Rmse` keeps the epoch of the lowest evaluator RMSE; `BestBy::TrainingLoss` (the
+/// published code's `best.ckpt`) the epoch of the lowest mean minibatch loss, whatever the
+/// evaluator says. Here the evaluator's RMSE worsens every epoch while the loss falls.
+#[test]
+fn the_best_model_follows_the_chosen_criterion() {
+    let obj = NoisyQuadratic {
+        c: vec![1.0, -2.0, 0.5],
+        noise: 0.0,
+        nan_radius: f64::INFINITY,
+    };
+    let run = |best_by: BestBy| {
+        let config = TrainConfig {
+            budget: Budget::Epochs(20),
+            batch_size: 1,
+            lr: 0.05,
+            best_by,
+            ..TrainConfig::default()
+        };
+        let mut calls = 0.0;
+        let mut evaluate = |_: &[f64]| {
+            calls += 1.0;
+            Ok(Evaluation {
+                train_rmse: Some(calls),
+                ..Evaluation::default()
+            })
+        };
+        let out = train(
+            &obj,
+            &[3],
+            &[0.0; 3],
+            &config,
+            TrainHooks {
+                evaluate: Some(&mut evaluate),
+                ..TrainHooks::default()
+            },
+            None,
+        )
+        .unwrap();
+        let best = out.state.best.unwrap();
+        let lowest_loss = out
+            .state
+            .history
+            .iter()
+            .min_by(|a, b| a.mean_loss.total_cmp(&b.mean_loss))
+            .unwrap()
+            .epoch;
+        (best.epoch, lowest_loss)
+    };
+    assert_eq!(run(BestBy::Rmse).0, 0);
+    let (best, lowest_loss) = run(BestBy::TrainingLoss);
+    assert_eq!(best, lowest_loss);
+    assert!(best > 10, "best epoch {best}");
 }

@@ -216,7 +216,7 @@ impl Stream {
 #[pyfunction]
 #[pyo3(signature = (dataset, out, preset="paper", dx=None, inducing=None, particles=None,
     epochs=None, iterations=None, batch=None, lr=None, seed=0, val_fraction=0.1,
-    checkpoint_every=10, resume=false, progress=None))]
+    checkpoint_every=10, resume=false, progress=None, best_by="rmse"))]
 #[allow(clippy::too_many_arguments)]
 pub fn train(
     py: Python<'_>,
@@ -235,7 +235,17 @@ pub fn train(
     checkpoint_every: u64,
     resume: bool,
     progress: Option<Py<PyAny>>,
+    best_by: &str,
 ) -> PyResult<Prssm> {
+    let best_by = match best_by {
+        "rmse" => flapssm_prssm::train::BestBy::Rmse,
+        "training-loss" => flapssm_prssm::train::BestBy::TrainingLoss,
+        other => {
+            return Err(PyValueError::new_err(format!(
+                "best_by = {other:?}: expected \"rmse\" or \"training-loss\""
+            )));
+        }
+    };
     let plan = TrainingOptions {
         preset: preset
             .parse()
@@ -251,6 +261,7 @@ pub fn train(
         eval_every: None,
         seed,
         val_fraction,
+        best_by,
         checkpoint_every,
     }
     .check()

@@ -94,6 +94,8 @@ def test_bad_input_raises_the_right_exception(small, tmp_path):
         flapssm.simulate(2, n_train=5)
     with pytest.raises(ValueError, match="preset"):
         flapssm.train(small, tmp_path / "m.json", preset="fast")
+    with pytest.raises(ValueError, match="best_by"):
+        flapssm.train(small, tmp_path / "m.json", best_by="lowest")
     with pytest.raises(OSError, match="is a directory"):
         small.save(tmp_path)
 

@@ -8,6 +8,7 @@ use flapssm_jobs::JobError;
 use flapssm_jobs::demo::{DEMO_FILES, DemoConfig, run_demo};
 use flapssm_jobs::evaluate::EVALUATION_FILES;
 use flapssm_jobs::files::check_output_dir;
+use flapssm_prssm::train::BestBy;
 
 use crate::progress::{Bars, stop_flag};
 
@@ -43,6 +44,14 @@ pub struct DemoArgs {
     /// low-order, the demo's default), l2 (vortex strips, the default of `simulate`).
     #[arg(long, value_name = "LEVEL")]
     fidelity: Option<String>,
+    /// Override the fraction of the training trajectories held out for validation (default
+    /// 0.1; with --full 0, the published protocol).
+    #[arg(long, value_name = "F")]
+    val_fraction: Option<f64>,
+    /// Override how the best model is chosen: rmse (validation, the default) or training-loss
+    /// (the published code's, the default with --full).
+    #[arg(long, value_name = "RULE", value_parser = ["rmse", "training-loss"])]
+    best_by: Option<String>,
 }
 
 /// Runs `flapssm demo`.
@@ -75,6 +84,16 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
     }
     if let Some(f) = &args.fidelity {
         cfg.simulation.wing.fidelity = f.parse().context("parsing --fidelity")?;
+    }
+    if let Some(v) = args.val_fraction {
+        cfg.training.val_fraction = v;
+    }
+    if let Some(b) = &args.best_by {
+        cfg.training.best_by = if b == "training-loss" {
+            BestBy::TrainingLoss
+        } else {
+            BestBy::Rmse
+        };
     }
     let stop = stop_flag()?;
     let bars = Bars::new();

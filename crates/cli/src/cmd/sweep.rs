@@ -112,6 +112,7 @@ fn run_one(a: RunArgs) -> anyhow::Result<()> {
         eval_every: a.eval_every,
         seed: a.seed,
         val_fraction: a.val_fraction,
+        best_by: Default::default(),
         checkpoint_every: 0,
     };
     let plan = SweepSettings {

@@ -3,16 +3,25 @@
 use std::path::PathBuf;
 
 use anyhow::{Context, bail};
-use clap::Args;
+use clap::{Args, ValueEnum};
 use flapssm_jobs::JobError;
 use flapssm_jobs::train::{TrainFiles, TrainingOptions, train_dataset};
-use flapssm_prssm::train::LrSchedule;
 use flapssm_prssm::train::fit::Preset;
+use flapssm_prssm::train::{BestBy, LrSchedule};
 use flapssm_wing::dataset::Dataset;
 
 use crate::progress::{Bars, stop_flag};
 
 /// Train a PR-SSM (negative-ELBO minimization with Adam).
+/// `--best-by`.
+#[derive(Clone, Copy, ValueEnum)]
+enum BestByArg {
+    /// Validation RMSE, else the training rollouts' RMSE.
+    Rmse,
+    /// The lowest epoch-mean training loss (−ELBO).
+    TrainingLoss,
+}
+
 #[derive(Args)]
 pub struct TrainArgs {
     /// Dataset file (flapssm .npz); its training trajectories are used.
@@ -55,6 +64,10 @@ pub struct TrainArgs {
     /// Fraction of the training trajectories (the last ones) held out for validation.
     #[arg(long, default_value_t = 0.1)]
     val_fraction: f64,
+    /// Best model by RMSE (validation, else training rollouts) or by the lowest epoch-mean
+    /// training loss (the published code's `best.ckpt`).
+    #[arg(long, value_enum, default_value = "rmse")]
+    best_by: BestByArg,
     /// Write a checkpoint every N epochs (0: only on Ctrl-C).
     #[arg(long, default_value_t = 10)]
     checkpoint_every: u64,
@@ -107,6 +120,10 @@ pub fn run(args: TrainArgs) -> anyhow::Result<()> {
         eval_every: None,
         seed: args.seed,
         val_fraction: args.val_fraction,
+        best_by: match args.best_by {
+            BestByArg::Rmse => BestBy::Rmse,
+            BestByArg::TrainingLoss => BestBy::TrainingLoss,
+        },
         checkpoint_every: args.checkpoint_every,
     }
     .check()?;

@@ -35,7 +35,8 @@ pub struct PrevStep {
 pub struct BestModel {
     /// Its parameters.
     pub params: Vec<f64>,
-    /// Its score (validation RMSE, else training RMSE, else mean epoch loss; lower is better).
+    /// Its score (by [`super::BestBy`]: validation RMSE, else training RMSE, else mean epoch
+    /// loss; or the mean epoch loss; lower is better).
     pub score: f64,
     /// Epoch (0-based) after which it was recorded.
     pub epoch: u64,

@@ -30,6 +30,6 @@ pub use initial::{InitialStateModel, InitialStateSpec, RecognizedElbo};
 pub use recognition::{Recognition, RecognitionConfig};
 pub use schedule::LrSchedule;
 pub use trainer::{
-    Budget, DivergenceGuard, Evaluation, TrainConfig, TrainError, TrainEvent, TrainHooks,
+    BestBy, Budget, DivergenceGuard, Evaluation, TrainConfig, TrainError, TrainEvent, TrainHooks,
     TrainOutcome, train,
 };

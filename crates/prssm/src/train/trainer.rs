@@ -65,6 +65,19 @@ impl Default for DivergenceGuard {
     }
 }
 
+/// Which evaluated epoch's parameters a run keeps as its best model.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum BestBy {
+    /// The lowest validation RMSE, else the evaluator's training RMSE, else the lowest
+    /// epoch-mean loss.
+    #[default]
+    Rmse,
+    /// The lowest epoch-mean training loss (the mean minibatch −ELBO of the epoch), as the
+    /// published code keeps `best.ckpt`.
+    TrainingLoss,
+}
+
 /// Configuration of a training run (all of it is stored in checkpoints).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct TrainConfig {
@@ -89,6 +102,9 @@ pub struct TrainConfig {
     pub checkpoint_every: u64,
     /// Divergence handling.
     pub divergence: DivergenceGuard,
+    /// How the best model is chosen among the evaluated epochs.
+    #[serde(default)]
+    pub best_by: BestBy,
     /// What else defines the run (e.g. the model specification and a fingerprint of the
     /// training data); compared like every other field when resuming. `null` if unused.
     #[serde(default)]
@@ -109,6 +125,7 @@ impl Default for TrainConfig {
             eval_every: 1,
             checkpoint_every: 0,
             divergence: DivergenceGuard::default(),
+            best_by: BestBy::default(),
             run_context: serde_json::Value::Null,
         }
     }
@@ -609,7 +626,10 @@ pub fn train<O: Objective + ?Sized>(
                     None => Evaluation::default(),
                 };
                 let mean_loss = state.epoch_loss_sum / state.epoch_batches.max(1) as f64;
-                let score = metrics.val_rmse.or(metrics.train_rmse).unwrap_or(mean_loss);
+                let score = match config.best_by {
+                    BestBy::Rmse => metrics.val_rmse.or(metrics.train_rmse).unwrap_or(mean_loss),
+                    BestBy::TrainingLoss => mean_loss,
+                };
                 let is_best =
                     score.is_finite() && state.best.as_ref().is_none_or(|b| score < b.score);
                 if is_best {

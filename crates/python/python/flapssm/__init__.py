@@ -168,14 +168,18 @@ def train(
     checkpoint_every: int = 10,
     resume: bool = False,
     progress: Optional[Progress] = None,
+    best_by: str = "rmse",
 ) -> "_native.Prssm":
     """Trains a PR-SSM (``flapssm train``) on the dataset's training trajectories; writes
     the best model to ``out``, the last to ``<out>.last.json`` and checkpoints to
     ``<out>.ckpt.json``. Ctrl-C raises ``KeyboardInterrupt`` after a checkpoint;
-    ``resume=True`` continues from it (a larger budget extends a finished run)."""
+    ``resume=True`` continues from it (a larger budget extends a finished run). ``best_by``:
+    ``"rmse"`` (validation, else training rollouts) or ``"training-loss"`` (the published
+    code's ``best.ckpt``; with ``val_fraction=0``, the published protocol)."""
     return _native.train(
         dataset, os.fspath(out), preset, dx, inducing, particles, epochs, iterations, batch,
         lr, int(seed), float(val_fraction), int(checkpoint_every), bool(resume), progress,
+        best_by,
     )
 
 
