@@ -39,7 +39,7 @@ use crate::models::lrqsm::LrqsmLoadModel;
 use crate::models::prssm::PrssmLoadModel;
 use crate::models::{BASELINES, Baseline, LoadModel, baseline};
 use crate::progress::Progress;
-use crate::simulate::simulate;
+use crate::simulate::{TrajectorySource, paper_dataset, simulate};
 use crate::train::{TrainingOptions, TrainingPlan, train_prssm};
 use flapssm_analysis::stats::{Interval, median};
 
@@ -76,6 +76,10 @@ pub struct DemoConfig {
     pub name: String,
     /// The virtual wing and its trajectories.
     pub simulation: SimulationConfig,
+    /// Where the trajectories come from: the generator of `simulation` or the paper's measured
+    /// ones (the first `simulation.trajectories.n_trajectories`).
+    #[serde(default)]
+    pub source: TrajectorySource,
     /// LRQSM feature set.
     pub lrqsm_features: FeatureSet,
     /// LRQSM elastic-net options.
@@ -106,6 +110,7 @@ impl DemoConfig {
             seed,
             name: "default".into(),
             simulation,
+            source: TrajectorySource::Generator,
             lrqsm_features: FeatureSet::Published,
             lrqsm: EnetOptions::default(),
             training: TrainingOptions {
@@ -128,8 +133,8 @@ impl DemoConfig {
         }
     }
 
-    /// The paper's configuration by the published protocol: 548 trajectories (512 train, 36
-    /// test), D_x 12, M 100, 30 particles, minibatches of 16, lr 0.03, 1000 epochs; all 512
+    /// The paper's configuration by the published protocol on the paper's 548 measured
+    /// trajectories (512 train, 36 test; [`TrajectorySource::Paper`]), D_x 12, M 100, 30 particles, minibatches of 16, lr 0.03, 1000 epochs; all 512
     /// training trajectories fitted (no validation hold-out: the normalization is theirs and an
     /// epoch is 32 minibatches, 32 000 steps in all) and the model of the lowest epoch-mean
     /// training loss kept, as the authors' `best.ckpt`; the wing at [`DEMO_FIDELITY`].
@@ -141,6 +146,7 @@ impl DemoConfig {
             seed,
             name: "full".into(),
             simulation,
+            source: TrajectorySource::Paper,
             lrqsm_features: FeatureSet::Published,
             lrqsm: EnetOptions::default(),
             training: TrainingOptions {
@@ -169,6 +175,15 @@ impl DemoConfig {
         t.check()
             .map_err(flapssm_wing::virtual_wing::SimulateError::from)?;
         crate::resources::check_dataset("trajectories", t.n_trajectories, t.sampling.n_samples)?;
+        if self.source == TrajectorySource::Paper
+            && t.n_trajectories > flapssm_wing::trajectories::paper::PAPER_N_TRAJECTORIES
+        {
+            return Err(JobError::Setting {
+                name: "trajectories".into(),
+                value: t.n_trajectories.to_string(),
+                expected: "at most the paper's 548 measured trajectories".into(),
+            });
+        }
         if t.n_train == 0 || t.n_train >= t.n_trajectories {
             return Err(JobError::Setting {
                 name: "trajectories".into(),
@@ -389,13 +404,27 @@ pub fn run_demo(
 
     // 1. Simulate.
     let ds_path = dir.join("dataset.npz");
-    let k_sim = serde_json::json!({ "simulation": json(&cfg.simulation), "version": env!("CARGO_PKG_VERSION") });
+    let k_sim = serde_json::json!({
+        "simulation": json(&cfg.simulation),
+        "source": cfg.source,
+        "version": env!("CARGO_PKG_VERSION"),
+    });
     let ds = run.stage(
         "simulate",
         &k_sim,
         &[&ds_path],
         || load_dataset(&ds_path),
-        |p| simulate(&cfg.simulation, Some(&ds_path), p),
+        |p| match cfg.source {
+            TrajectorySource::Generator => simulate(&cfg.simulation, Some(&ds_path), p),
+            TrajectorySource::Paper => {
+                let ds = paper_dataset(&cfg.simulation, p)?;
+                ds.save(&ds_path).map_err(|source| JobError::DatasetFile {
+                    path: ds_path.clone(),
+                    source,
+                })?;
+                Ok(ds)
+            }
+        },
     )?;
 
     // 2. LRQSM.
@@ -654,6 +683,11 @@ mod tests {
     #[test]
     fn full_is_the_published_protocol() {
         let full = DemoConfig::full(3);
+        assert_eq!(full.source, TrajectorySource::Paper);
+        let mut too_many = full.clone();
+        too_many.simulation.trajectories.n_trajectories = 600;
+        let e = too_many.check().unwrap_err().to_string();
+        assert!(e.contains("setting trajectories = 600"), "{e}");
         let plan = full.training.check().unwrap();
         let t = &full.simulation.trajectories;
         assert_eq!((t.n_trajectories, t.n_train), (548, 512));

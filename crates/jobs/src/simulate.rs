@@ -2,6 +2,8 @@
 
 use std::path::Path;
 
+use serde::{Deserialize, Serialize};
+
 use flapssm_wing::dataset::ValidDataset;
 use flapssm_wing::sensor::SensorConfig;
 use flapssm_wing::trajectories::paper::{PAPER_ANGLE_SIGNS, PAPER_N_TRAJECTORIES, paper_angles};
@@ -150,6 +152,17 @@ pub fn simulate_angles(
     Ok(ds)
 }
 
+/// Where a simulation's trajectories come from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum TrajectorySource {
+    /// The seeded generator of the configuration.
+    #[default]
+    Generator,
+    /// The paper's measured trajectories ([`flapssm_wing::trajectories::paper`]).
+    Paper,
+}
+
 /// Simulates the wing of `settings` on the paper's measured trajectories
 /// ([`flapssm_wing::trajectories::paper`]): the first `n_trajectories` (at most 548, in the
 /// authors' order; all 548 give the published split, 512 training and the paper's 36 test
@@ -162,14 +175,6 @@ pub fn simulate_paper(
     settings: &SimulateSettings,
     progress: &dyn Progress,
 ) -> Result<ValidDataset> {
-    let n = settings.n_trajectories;
-    if n > PAPER_N_TRAJECTORIES {
-        return Err(JobError::Setting {
-            name: "n".into(),
-            value: n.to_string(),
-            expected: format!("at most the paper's {PAPER_N_TRAJECTORIES} measured trajectories"),
-        });
-    }
     if settings.flat {
         return Err(JobError::Setting {
             name: "flat".into(),
@@ -177,11 +182,41 @@ pub fn simulate_paper(
             expected: "not with the measured trajectories (their deviation is measured)".into(),
         });
     }
+    paper_dataset(&settings.check()?, progress)
+}
+
+/// The wing of `cfg` (its sensor seed and split from `cfg.trajectories`) on the paper's first
+/// `cfg.trajectories.n_trajectories` measured trajectories; the generator's other settings do
+/// not apply. `progress.advance(1)` per trajectory.
+///
+/// # Errors
+/// [`JobError::Setting`] for more than 548 trajectories; the simulation's errors.
+pub fn paper_dataset(cfg: &SimulationConfig, progress: &dyn Progress) -> Result<ValidDataset> {
+    let t = &cfg.trajectories;
+    let n = t.n_trajectories;
+    if n > PAPER_N_TRAJECTORIES {
+        return Err(JobError::Setting {
+            name: "n".into(),
+            value: n.to_string(),
+            expected: format!("at most the paper's {PAPER_N_TRAJECTORIES} measured trajectories"),
+        });
+    }
     let source = format!(
         "Bayiz & Cheng (2021) measured trajectories 0..{n} (crates/wing/data/bayiz2021-euler-angles.npy, \
          signs {PAPER_ANGLE_SIGNS:?} to [stroke, deviation, pitch])"
     );
-    simulate_angles(settings, &paper_angles(n), &source, progress)
+    progress.start("simulate", n as u64);
+    let ds = simulate_angles_dataset(
+        &cfg.wing,
+        &paper_angles(n),
+        &t.sampling,
+        t.seed,
+        t.n_train,
+        &source,
+        &|| progress.advance(1),
+    )?;
+    progress.finish(&format!("{} trajectories", ds.len()));
+    Ok(ds)
 }
 
 #[cfg(test)]

@@ -8,6 +8,7 @@ use flapssm_jobs::JobError;
 use flapssm_jobs::demo::{DEMO_FILES, DemoConfig, run_demo};
 use flapssm_jobs::evaluate::EVALUATION_FILES;
 use flapssm_jobs::files::check_output_dir;
+use flapssm_jobs::simulate::TrajectorySource;
 use flapssm_prssm::train::BestBy;
 
 use crate::progress::{Bars, stop_flag};
@@ -52,6 +53,10 @@ pub struct DemoArgs {
     /// (the published code's, the default with --full).
     #[arg(long, value_name = "RULE", value_parser = ["rmse", "training-loss"])]
     best_by: Option<String>,
+    /// Override where the trajectories come from: generator (the default) or paper (the
+    /// paper's measured trajectories, the default with --full; the first --trajectories).
+    #[arg(long, value_name = "SOURCE", value_parser = ["generator", "paper"])]
+    source: Option<String>,
 }
 
 /// Runs `flapssm demo`.
@@ -84,6 +89,13 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
     }
     if let Some(f) = &args.fidelity {
         cfg.simulation.wing.fidelity = f.parse().context("parsing --fidelity")?;
+    }
+    if let Some(source) = &args.source {
+        cfg.source = if source == "paper" {
+            TrajectorySource::Paper
+        } else {
+            TrajectorySource::Generator
+        };
     }
     if let Some(v) = args.val_fraction {
         cfg.training.val_fraction = v;
