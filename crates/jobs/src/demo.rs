@@ -39,7 +39,7 @@ use crate::models::lrqsm::LrqsmLoadModel;
 use crate::models::prssm::PrssmLoadModel;
 use crate::models::{BASELINES, Baseline, LoadModel, baseline};
 use crate::progress::Progress;
-use crate::simulate::{TrajectorySource, paper_dataset, simulate};
+use crate::simulate::{TrajectorySource, check_paper_count, paper_dataset, simulate};
 use crate::train::{TrainingOptions, TrainingPlan, train_prssm};
 use flapssm_analysis::stats::{Interval, median};
 
@@ -175,14 +175,8 @@ impl DemoConfig {
         t.check()
             .map_err(flapssm_wing::virtual_wing::SimulateError::from)?;
         crate::resources::check_dataset("trajectories", t.n_trajectories, t.sampling.n_samples)?;
-        if self.source == TrajectorySource::Paper
-            && t.n_trajectories > flapssm_wing::trajectories::paper::PAPER_N_TRAJECTORIES
-        {
-            return Err(JobError::Setting {
-                name: "trajectories".into(),
-                value: t.n_trajectories.to_string(),
-                expected: "at most the paper's 548 measured trajectories".into(),
-            });
+        if self.source == TrajectorySource::Paper {
+            check_paper_count("trajectories", t.n_trajectories)?;
         }
         if t.n_train == 0 || t.n_train >= t.n_trajectories {
             return Err(JobError::Setting {
@@ -416,14 +410,7 @@ pub fn run_demo(
         || load_dataset(&ds_path),
         |p| match cfg.source {
             TrajectorySource::Generator => simulate(&cfg.simulation, Some(&ds_path), p),
-            TrajectorySource::Paper => {
-                let ds = paper_dataset(&cfg.simulation, p)?;
-                ds.save(&ds_path).map_err(|source| JobError::DatasetFile {
-                    path: ds_path.clone(),
-                    source,
-                })?;
-                Ok(ds)
-            }
+            TrajectorySource::Paper => paper_dataset(&cfg.simulation, Some(&ds_path), p),
         },
     )?;
 

@@ -105,12 +105,7 @@ pub fn simulate(
 ) -> Result<ValidDataset> {
     progress.start("simulate", cfg.trajectories.n_trajectories as u64);
     let ds = simulate_dataset(cfg, &|| progress.advance(1))?;
-    if let Some(path) = out {
-        ds.save(path).map_err(|source| JobError::DatasetFile {
-            path: path.to_path_buf(),
-            source,
-        })?;
-    }
+    save_if(&ds, out)?;
     progress.finish(&format!("{} trajectories", ds.len()));
     Ok(ds)
 }
@@ -182,25 +177,40 @@ pub fn simulate_paper(
             expected: "not with the measured trajectories (their deviation is measured)".into(),
         });
     }
-    paper_dataset(&settings.check()?, progress)
+    paper_dataset(&settings.check()?, None, progress)
 }
 
-/// The wing of `cfg` (its sensor seed and split from `cfg.trajectories`) on the paper's first
-/// `cfg.trajectories.n_trajectories` measured trajectories; the generator's other settings do
-/// not apply. `progress.advance(1)` per trajectory.
+/// Refuses more than the paper's 548 measured trajectories, naming the setting `name`.
 ///
 /// # Errors
-/// [`JobError::Setting`] for more than 548 trajectories; the simulation's errors.
-pub fn paper_dataset(cfg: &SimulationConfig, progress: &dyn Progress) -> Result<ValidDataset> {
-    let t = &cfg.trajectories;
-    let n = t.n_trajectories;
+/// [`JobError::Setting`] for `n` above 548.
+pub fn check_paper_count(name: &str, n: usize) -> Result<()> {
     if n > PAPER_N_TRAJECTORIES {
         return Err(JobError::Setting {
-            name: "n".into(),
+            name: name.into(),
             value: n.to_string(),
             expected: format!("at most the paper's {PAPER_N_TRAJECTORIES} measured trajectories"),
         });
     }
+    Ok(())
+}
+
+/// The wing of `cfg` (its sensor seed and split from `cfg.trajectories`) on the paper's first
+/// `cfg.trajectories.n_trajectories` measured trajectories; the generator's other settings do
+/// not apply. `progress.advance(1)` per trajectory; with `out`, the dataset file is written
+/// atomically, as [`simulate`] writes it.
+///
+/// # Errors
+/// [`JobError::Setting`] for more than 548 trajectories; the simulation's errors;
+/// [`JobError::DatasetFile`] naming `out`.
+pub fn paper_dataset(
+    cfg: &SimulationConfig,
+    out: Option<&Path>,
+    progress: &dyn Progress,
+) -> Result<ValidDataset> {
+    let t = &cfg.trajectories;
+    let n = t.n_trajectories;
+    check_paper_count("n", n)?;
     let source = format!(
         "Bayiz & Cheng (2021) measured trajectories 0..{n} (crates/wing/data/bayiz2021-euler-angles.npy, \
          signs {PAPER_ANGLE_SIGNS:?} to [stroke, deviation, pitch])"
@@ -215,8 +225,20 @@ pub fn paper_dataset(cfg: &SimulationConfig, progress: &dyn Progress) -> Result<
         &source,
         &|| progress.advance(1),
     )?;
+    save_if(&ds, out)?;
     progress.finish(&format!("{} trajectories", ds.len()));
     Ok(ds)
+}
+
+/// Writes `ds` to `out` atomically, if given.
+fn save_if(ds: &ValidDataset, out: Option<&Path>) -> Result<()> {
+    match out {
+        Some(path) => ds.save(path).map_err(|source| JobError::DatasetFile {
+            path: path.to_path_buf(),
+            source,
+        }),
+        None => Ok(()),
+    }
 }
 
 #[cfg(test)]

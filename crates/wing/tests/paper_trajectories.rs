@@ -6,21 +6,10 @@ use flapssm_wing::differentiate::{SavitzkyGolayConfig, measured_inputs};
 use flapssm_wing::trajectories::paper::{
     PAPER_DT_S, PAPER_N_TRAIN, PAPER_N_TRAJECTORIES, paper_angles,
 };
+use flapssm_wing::trajectories::stats::pearson;
 
 /// First sample of the published evaluation window (MATLAB sample 94).
 const START: usize = 93;
-
-fn corr(a: &[f64], b: &[f64]) -> f64 {
-    let n = a.len() as f64;
-    let (ma, mb) = (a.iter().sum::<f64>() / n, b.iter().sum::<f64>() / n);
-    let (mut sab, mut saa, mut sbb) = (0.0, 0.0, 0.0);
-    for (x, y) in a.iter().zip(b) {
-        sab += (x - ma) * (y - mb);
-        saa += (x - ma) * (x - ma);
-        sbb += (y - mb) * (y - mb);
-    }
-    sab / (saa * sbb).sqrt()
-}
 
 /// Amplitude of harmonic `k` (of the window's length) of `x`, by a direct DFT.
 fn harmonic(x: &[f64], k: usize) -> f64 {
@@ -50,7 +39,7 @@ fn deviation_shape(t: &[[f64; 3]]) -> (f64, f64, f64) {
         harmonic(&psi, 2 * k)
             .max(harmonic(&psi, 2 * k + 1))
             .max(harmonic(&psi, 2 * k - 1)),
-        corr(&psi, &abs_phi),
+        pearson(&psi, &abs_phi),
     )
 }
 

@@ -8,9 +8,8 @@ use flapssm_jobs::JobError;
 use flapssm_jobs::demo::{DEMO_FILES, DemoConfig, run_demo};
 use flapssm_jobs::evaluate::EVALUATION_FILES;
 use flapssm_jobs::files::check_output_dir;
-use flapssm_jobs::simulate::TrajectorySource;
-use flapssm_prssm::train::BestBy;
 
+use crate::cmd::choices::{BestByArg, SourceArg};
 use crate::progress::{Bars, stop_flag};
 
 /// Run the whole pipeline on a simulated wing.
@@ -51,12 +50,12 @@ pub struct DemoArgs {
     val_fraction: Option<f64>,
     /// Override how the best model is chosen: rmse (validation, the default) or training-loss
     /// (the published code's, the default with --full).
-    #[arg(long, value_name = "RULE", value_parser = ["rmse", "training-loss"])]
-    best_by: Option<String>,
+    #[arg(long, value_enum, value_name = "RULE")]
+    best_by: Option<BestByArg>,
     /// Override where the trajectories come from: generator (the default) or paper (the
     /// paper's measured trajectories, the default with --full; the first --trajectories).
-    #[arg(long, value_name = "SOURCE", value_parser = ["generator", "paper"])]
-    source: Option<String>,
+    #[arg(long, value_enum, value_name = "SOURCE")]
+    source: Option<SourceArg>,
 }
 
 /// Runs `flapssm demo`.
@@ -90,22 +89,14 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
     if let Some(f) = &args.fidelity {
         cfg.simulation.wing.fidelity = f.parse().context("parsing --fidelity")?;
     }
-    if let Some(source) = &args.source {
-        cfg.source = if source == "paper" {
-            TrajectorySource::Paper
-        } else {
-            TrajectorySource::Generator
-        };
+    if let Some(source) = args.source {
+        cfg.source = source.into();
     }
     if let Some(v) = args.val_fraction {
         cfg.training.val_fraction = v;
     }
-    if let Some(b) = &args.best_by {
-        cfg.training.best_by = if b == "training-loss" {
-            BestBy::TrainingLoss
-        } else {
-            BestBy::Rmse
-        };
+    if let Some(b) = args.best_by {
+        cfg.training.best_by = b.into();
     }
     let stop = stop_flag()?;
     let bars = Bars::new();

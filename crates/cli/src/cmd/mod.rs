@@ -1,6 +1,7 @@
 //! One module per subcommand group.
 
 pub mod bench;
+pub mod choices;
 pub mod dataset;
 pub mod demo;
 pub mod evaluate;

@@ -5,28 +5,20 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::Context;
-use clap::{Args, ValueEnum};
+use clap::Args;
 use flapssm_jobs::NoProgress;
 use flapssm_jobs::simulate::{SimulateSettings, simulate, simulate_paper};
 use flapssm_wing::virtual_wing::Fidelity;
 
+use crate::cmd::choices::SourceArg;
 use crate::progress::Bars;
-
-/// Where the wing's trajectories come from.
-#[derive(Clone, Copy, ValueEnum)]
-enum Source {
-    /// The seeded random trajectory generator.
-    Generator,
-    /// The paper's 548 measured trajectories (Bayiz & Cheng 2021, vendored; the first N).
-    Paper,
-}
 
 /// Simulate the robotic wing (aerodynamics + sensor chain) on generated or measured trajectories.
 #[derive(Args)]
 pub struct SimulateArgs {
     /// Trajectories: the seeded generator, or the paper's measured set.
     #[arg(long, value_enum, default_value = "generator")]
-    source: Source,
+    source: SourceArg,
     /// Number of trajectories (with --source paper: the first N of 548).
     #[arg(long, value_name = "N", default_value_t = 548)]
     n: usize,
@@ -70,8 +62,8 @@ pub fn run(args: SimulateArgs) -> anyhow::Result<()> {
     let bars = Bars::new();
     let progress: &dyn flapssm_jobs::Progress = if args.quiet { &NoProgress } else { &bars };
     let ds = match args.source {
-        Source::Generator => simulate(&cfg, None, progress),
-        Source::Paper => simulate_paper(&settings, progress),
+        SourceArg::Generator => simulate(&cfg, None, progress),
+        SourceArg::Paper => simulate_paper(&settings, progress),
     }
     .context("simulating the wing")?;
     let sim_s = start.elapsed().as_secs_f64();
@@ -86,8 +78,8 @@ pub fn run(args: SimulateArgs) -> anyhow::Result<()> {
         args.out.display(),
         ds.trajectories.len(),
         match args.source {
-            Source::Generator => "generated",
-            Source::Paper => "measured (the paper's)",
+            SourceArg::Generator => "generated",
+            SourceArg::Paper => "measured (the paper's)",
         },
         ds.n_train,
         cfg.trajectories.sampling.n_samples,

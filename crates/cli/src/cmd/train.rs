@@ -3,25 +3,17 @@
 use std::path::PathBuf;
 
 use anyhow::{Context, bail};
-use clap::{Args, ValueEnum};
+use clap::Args;
 use flapssm_jobs::JobError;
 use flapssm_jobs::train::{TrainFiles, TrainingOptions, train_dataset};
+use flapssm_prssm::train::LrSchedule;
 use flapssm_prssm::train::fit::Preset;
-use flapssm_prssm::train::{BestBy, LrSchedule};
 use flapssm_wing::dataset::Dataset;
 
+use crate::cmd::choices::BestByArg;
 use crate::progress::{Bars, stop_flag};
 
 /// Train a PR-SSM (negative-ELBO minimization with Adam).
-/// `--best-by`.
-#[derive(Clone, Copy, ValueEnum)]
-enum BestByArg {
-    /// Validation RMSE, else the training rollouts' RMSE.
-    Rmse,
-    /// The lowest epoch-mean training loss (−ELBO).
-    TrainingLoss,
-}
-
 #[derive(Args)]
 pub struct TrainArgs {
     /// Dataset file (flapssm .npz); its training trajectories are used.
@@ -120,10 +112,7 @@ pub fn run(args: TrainArgs) -> anyhow::Result<()> {
         eval_every: None,
         seed: args.seed,
         val_fraction: args.val_fraction,
-        best_by: match args.best_by {
-            BestByArg::Rmse => BestBy::Rmse,
-            BestByArg::TrainingLoss => BestBy::TrainingLoss,
-        },
+        best_by: args.best_by.into(),
         checkpoint_every: args.checkpoint_every,
     }
     .check()?;

@@ -554,14 +554,10 @@ impl GeneratorConfig {
     /// for φ̇ > 0 and +|AoA| for φ̇ < 0; one half-stroke near zero or reversed with the
     /// configured probabilities.
     fn aoa_targets(&self, rng: &mut ChaCha8Rng) -> [f64; 2] {
-        let u = |rng: &mut ChaCha8Rng, r: [f64; 2]| {
-            if r[1] > r[0] {
-                rng.random_range(r[0]..r[1])
-            } else {
-                r[0]
-            }
-        };
-        let mut targets = [-u(rng, self.aoa_deg) * DEG, u(rng, self.aoa_deg) * DEG];
+        let mut targets = [
+            -uniform(rng, self.aoa_deg) * DEG,
+            uniform(rng, self.aoa_deg) * DEG,
+        ];
         let which = rng.random_range(0..2usize);
         let sign = if which == 0 { -1.0 } else { 1.0 };
         let p: f64 = rng.random();
@@ -574,16 +570,11 @@ impl GeneratorConfig {
     }
 
     fn draw(&self, rng: &mut ChaCha8Rng, family: Family) -> Option<TrajectorySpec> {
-        let u = |rng: &mut ChaCha8Rng, r: [f64; 2]| {
-            if r[1] > r[0] {
-                rng.random_range(r[0]..r[1])
-            } else {
-                r[0]
-            }
-        };
-        let drawn_f = u(rng, self.frequency_hz);
-        let ramp_cycles = u(rng, self.ramp_cycles);
-        let amp = u(rng, self.stroke_amplitude_deg) * DEG;
+        // Drawn in either frequency mode, so that the other draws of a trajectory do not depend
+        // on the mode.
+        let drawn_f = uniform(rng, self.frequency_hz);
+        let ramp_cycles = uniform(rng, self.ramp_cycles);
+        let amp = uniform(rng, self.stroke_amplitude_deg) * DEG;
         let max_dev = self.max_deviation_deg * DEG;
 
         // Stroke: Φ (sin x + c3 sin 3x + c2 sin 2x) / peak + φ₀.
@@ -591,7 +582,7 @@ impl GeneratorConfig {
         stroke.add_sin(1, 1.0, 0.0);
         stroke.add_sin(3, rng.random_range(-0.1..0.03), 0.0);
         let h2 = self.stroke_second_harmonic;
-        stroke.add_sin(2, u(rng, [-h2, h2]), rng.random_range(-PI..PI));
+        stroke.add_sin(2, uniform(rng, [-h2, h2]), rng.random_range(-PI..PI));
         if family == Family::Harmonic {
             for k in 2..=4 {
                 stroke.add_sin(
@@ -664,17 +655,18 @@ impl GeneratorConfig {
         }
         if family != Family::Flat {
             let o = self.max_deviation_offset_deg;
-            dev.offset_rad = u(rng, [-o, o]) * DEG;
+            dev.offset_rad = uniform(rng, [-o, o]) * DEG;
         }
 
         let drawn_pitch = match self.pitch_half_range_deg {
-            Some(range) => {
-                PitchDraw::HalfRangeOffset(u(rng, range) * DEG, u(rng, self.pitch_offset_deg) * DEG)
-            }
+            Some(range) => PitchDraw::HalfRangeOffset(
+                uniform(rng, range) * DEG,
+                uniform(rng, self.pitch_offset_deg) * DEG,
+            ),
             None => PitchDraw::AoaTargets(self.aoa_targets(rng)),
         };
         let phase = self.max_pitch_phase_cycles;
-        let delta = u(rng, [-phase, phase]) * 2.0 * PI;
+        let delta = uniform(rng, [-phase, phase]) * 2.0 * PI;
         let aoa_flat = |x: f64| {
             let [p0, p1, _] = stroke.eval(x);
             let [d0, d1, _] = dev.eval(x);
@@ -742,6 +734,15 @@ impl GeneratorConfig {
             angles: [stroke, dev, pitch],
             aoa_targets_rad: targets,
         })
+    }
+}
+
+/// A uniform draw from [r₀, r₁), or r₀ for an empty range.
+fn uniform(rng: &mut ChaCha8Rng, r: [f64; 2]) -> f64 {
+    if r[1] > r[0] {
+        rng.random_range(r[0]..r[1])
+    } else {
+        r[0]
     }
 }
 

@@ -125,13 +125,17 @@ fn mean_pitch_deg(w: &[[f64; 3]], crossings: &[f64], dt_s: f64) -> f64 {
 
 /// Pearson r of α_i and (φ_{i+1} − φ_{i−1}) over the interior samples.
 fn pitch_stroke_rate_corr(w: &[[f64; 3]]) -> f64 {
-    let pairs: Vec<(f64, f64)> = w.windows(3).map(|p| (p[1][2], p[2][0] - p[0][0])).collect();
-    let n = pairs.len() as f64;
-    let (ma, mb) = pairs
-        .iter()
-        .fold((0.0, 0.0), |(a, b), (x, y)| (a + x / n, b + y / n));
+    let (pitch, stroke_rate): (Vec<f64>, Vec<f64>) =
+        w.windows(3).map(|p| (p[1][2], p[2][0] - p[0][0])).unzip();
+    pearson(&pitch, &stroke_rate)
+}
+
+/// Pearson correlation of `a` and `b` (equal lengths; NaN when either is constant).
+pub fn pearson(a: &[f64], b: &[f64]) -> f64 {
+    let n = a.len() as f64;
+    let (ma, mb) = (a.iter().sum::<f64>() / n, b.iter().sum::<f64>() / n);
     let (mut sab, mut saa, mut sbb) = (0.0, 0.0, 0.0);
-    for (x, y) in &pairs {
+    for (x, y) in a.iter().zip(b) {
         sab += (x - ma) * (y - mb);
         saa += (x - ma) * (x - ma);
         sbb += (y - mb) * (y - mb);

@@ -1,0 +1,41 @@
+//! Command-line choices that more than one subcommand takes.
+
+use clap::ValueEnum;
+use flapssm_jobs::simulate::TrajectorySource;
+use flapssm_prssm::train::BestBy;
+
+/// `--source`: where the wing's trajectories come from.
+#[derive(Clone, Copy, ValueEnum)]
+pub enum SourceArg {
+    /// The seeded random trajectory generator.
+    Generator,
+    /// The paper's 548 measured trajectories (Bayiz & Cheng 2021, vendored; the first N).
+    Paper,
+}
+
+impl From<SourceArg> for TrajectorySource {
+    fn from(s: SourceArg) -> Self {
+        match s {
+            SourceArg::Generator => TrajectorySource::Generator,
+            SourceArg::Paper => TrajectorySource::Paper,
+        }
+    }
+}
+
+/// `--best-by`: which evaluated epoch's model is kept.
+#[derive(Clone, Copy, ValueEnum)]
+pub enum BestByArg {
+    /// Validation RMSE, else the training rollouts' RMSE.
+    Rmse,
+    /// The lowest epoch-mean training loss (−ELBO), the published code's `best.ckpt`.
+    TrainingLoss,
+}
+
+impl From<BestByArg> for BestBy {
+    fn from(b: BestByArg) -> Self {
+        match b {
+            BestByArg::Rmse => BestBy::Rmse,
+            BestByArg::TrainingLoss => BestBy::TrainingLoss,
+        }
+    }
+}
