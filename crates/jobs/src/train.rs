@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 
 use flapssm_prssm::SequenceView;
-use flapssm_prssm::train::fit::{FitError, FitOutcome, FitSpec, Preset, fit};
+use flapssm_prssm::train::fit::{FitError, FitOutcome, FitSpec, ObjectiveForm, Preset, fit};
 use flapssm_prssm::train::{BestBy, Budget, Checkpoint, LrSchedule, TrainEvent, TrainHooks};
 use flapssm_wing::dataset::{Trajectory, ValidDataset};
 use serde::{Deserialize, Serialize};
@@ -45,6 +45,9 @@ pub struct TrainingOptions {
     /// published code, by the lowest epoch-mean training loss.
     #[serde(default)]
     pub best_by: BestBy,
+    /// The training objective: the standard ELBO or the published code's (both quirks).
+    #[serde(default)]
+    pub objective: ObjectiveForm,
     /// Checkpoint every this many epochs (0: only when interrupted).
     pub checkpoint_every: u64,
 }
@@ -66,6 +69,7 @@ impl Default for TrainingOptions {
             seed: 0,
             val_fraction: 0.1,
             best_by: BestBy::Rmse,
+            objective: ObjectiveForm::Standard,
             checkpoint_every: 10,
         }
     }
@@ -106,7 +110,7 @@ impl TrainingOptions {
         spec.train.seed = self.seed;
         spec.train.checkpoint_every = self.checkpoint_every;
         spec.train.best_by = self.best_by;
-        spec
+        spec.with_objective(self.objective)
     }
 
     /// Checks every setting once, before any work, and returns the validated plan.
@@ -544,5 +548,24 @@ mod tests {
             f.train.checkpoint_every = 10;
             f
         });
+    }
+
+    #[test]
+    fn objective_option_switches_loss_and_sampling_together() {
+        let p = TrainingOptions {
+            objective: ObjectiveForm::PublishedCode,
+            ..TrainingOptions::default()
+        }
+        .spec();
+        assert_eq!(p.objective, ObjectiveForm::PublishedCode);
+        assert!(p.model.shared_draws && p.model.matern_tau_jitter == 1e-8);
+        assert!(p.check_objective().is_ok());
+        let s = TrainingOptions::default().spec();
+        assert_eq!(s.objective, ObjectiveForm::Standard);
+        assert!(!s.model.shared_draws && s.model.matern_tau_jitter == 0.0);
+        // A spec whose sampling disagrees with its objective is refused, naming the field.
+        let mut mixed = s.clone();
+        mixed.objective = ObjectiveForm::PublishedCode;
+        assert_eq!(mixed.check_objective().unwrap_err().field, "shared_draws");
     }
 }

@@ -96,6 +96,13 @@ impl ModelConfig {
         self
     }
 
+    /// The correct sampling of [`Self::new`]: `matern_tau_jitter = 0` and independent draws.
+    pub fn standard_sampling(mut self) -> Self {
+        self.matern_tau_jitter = 0.0;
+        self.shared_draws = false;
+        self
+    }
+
     /// GP input dimension `D = D_x + D_u`.
     pub fn n_gp_input(&self) -> usize {
         self.n_state + self.n_input

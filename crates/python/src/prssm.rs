@@ -216,7 +216,8 @@ impl Stream {
 #[pyfunction]
 #[pyo3(signature = (dataset, out, preset="paper", dx=None, inducing=None, particles=None,
     epochs=None, iterations=None, batch=None, lr=None, seed=0, val_fraction=0.1,
-    checkpoint_every=10, resume=false, progress=None, best_by="rmse"))]
+    checkpoint_every=10, resume=false, progress=None, best_by="rmse",
+    objective="standard"))]
 #[allow(clippy::too_many_arguments)]
 pub fn train(
     py: Python<'_>,
@@ -236,6 +237,7 @@ pub fn train(
     resume: bool,
     progress: Option<Py<PyAny>>,
     best_by: &str,
+    objective: &str,
 ) -> PyResult<Prssm> {
     let best_by = match best_by {
         "rmse" => flapssm_prssm::train::BestBy::Rmse,
@@ -243,6 +245,15 @@ pub fn train(
         other => {
             return Err(PyValueError::new_err(format!(
                 "best_by = {other:?}: expected \"rmse\" or \"training-loss\""
+            )));
+        }
+    };
+    let objective = match objective {
+        "standard" => flapssm_prssm::train::fit::ObjectiveForm::Standard,
+        "published-code" => flapssm_prssm::train::fit::ObjectiveForm::PublishedCode,
+        other => {
+            return Err(PyValueError::new_err(format!(
+                "objective = {other:?}: expected \"standard\" or \"published-code\""
             )));
         }
     };
@@ -262,6 +273,7 @@ pub fn train(
         seed,
         val_fraction,
         best_by,
+        objective,
         checkpoint_every,
     }
     .check()

@@ -96,6 +96,8 @@ def test_bad_input_raises_the_right_exception(small, tmp_path):
         flapssm.train(small, tmp_path / "m.json", preset="fast")
     with pytest.raises(ValueError, match="best_by"):
         flapssm.train(small, tmp_path / "m.json", best_by="lowest")
+    with pytest.raises(ValueError, match="objective"):
+        flapssm.train(small, tmp_path / "m.json", objective="tf1")
     with pytest.raises(OSError, match="is a directory"):
         small.save(tmp_path)
 

@@ -3,6 +3,7 @@
 use clap::ValueEnum;
 use flapssm_jobs::simulate::TrajectorySource;
 use flapssm_prssm::train::BestBy;
+use flapssm_prssm::train::fit::ObjectiveForm;
 
 /// `--source`: where the wing's trajectories come from.
 #[derive(Clone, Copy, ValueEnum)]
@@ -36,6 +37,25 @@ impl From<BestByArg> for BestBy {
         match b {
             BestByArg::Rmse => BestBy::Rmse,
             BestByArg::TrainingLoss => BestBy::TrainingLoss,
+        }
+    }
+}
+
+/// `--objective`: which training objective is minimized.
+#[derive(Clone, Copy, ValueEnum)]
+pub enum ObjectiveArg {
+    /// The unbiased minibatch ELBO with independent noise draws.
+    Standard,
+    /// The published code's: likelihood summed over particles, one KL per minibatch, one
+    /// noise draw per particle and step shared by all latent dims.
+    PublishedCode,
+}
+
+impl From<ObjectiveArg> for ObjectiveForm {
+    fn from(o: ObjectiveArg) -> Self {
+        match o {
+            ObjectiveArg::Standard => ObjectiveForm::Standard,
+            ObjectiveArg::PublishedCode => ObjectiveForm::PublishedCode,
         }
     }
 }

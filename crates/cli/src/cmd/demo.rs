@@ -9,7 +9,7 @@ use flapssm_jobs::demo::{DEMO_FILES, DemoConfig, run_demo};
 use flapssm_jobs::evaluate::EVALUATION_FILES;
 use flapssm_jobs::files::check_output_dir;
 
-use crate::cmd::choices::{BestByArg, SourceArg};
+use crate::cmd::choices::{BestByArg, ObjectiveArg, SourceArg};
 use crate::progress::{Bars, stop_flag};
 
 /// Run the whole pipeline on a simulated wing.
@@ -52,6 +52,10 @@ pub struct DemoArgs {
     /// (the published code's, the default with --full).
     #[arg(long, value_enum, value_name = "RULE")]
     best_by: Option<BestByArg>,
+    /// Override the training objective: standard (the default) or published-code (the
+    /// authors' objective and shared noise draws).
+    #[arg(long, value_enum, value_name = "FORM")]
+    objective: Option<ObjectiveArg>,
     /// Override where the trajectories come from: generator (the default) or paper (the
     /// paper's measured trajectories, the default with --full; the first --trajectories).
     #[arg(long, value_enum, value_name = "SOURCE")]
@@ -97,6 +101,9 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
     }
     if let Some(b) = args.best_by {
         cfg.training.best_by = b.into();
+    }
+    if let Some(o) = args.objective {
+        cfg.training.objective = o.into();
     }
     let stop = stop_flag()?;
     let bars = Bars::new();

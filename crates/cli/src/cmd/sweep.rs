@@ -113,6 +113,7 @@ fn run_one(a: RunArgs) -> anyhow::Result<()> {
         seed: a.seed,
         val_fraction: a.val_fraction,
         best_by: Default::default(),
+        objective: Default::default(),
         checkpoint_every: 0,
     };
     let plan = SweepSettings {

@@ -10,7 +10,7 @@ use flapssm_prssm::train::LrSchedule;
 use flapssm_prssm::train::fit::Preset;
 use flapssm_wing::dataset::Dataset;
 
-use crate::cmd::choices::BestByArg;
+use crate::cmd::choices::{BestByArg, ObjectiveArg};
 use crate::progress::{Bars, stop_flag};
 
 /// Train a PR-SSM (negative-ELBO minimization with Adam).
@@ -60,6 +60,10 @@ pub struct TrainArgs {
     /// training loss (the published code's `best.ckpt`).
     #[arg(long, value_enum, default_value = "rmse")]
     best_by: BestByArg,
+    /// Training objective: standard (the unbiased ELBO) or published-code (the authors'
+    /// objective and shared noise draws, to re-run their exact training).
+    #[arg(long, value_enum, default_value = "standard")]
+    objective: ObjectiveArg,
     /// Write a checkpoint every N epochs (0: only on Ctrl-C).
     #[arg(long, default_value_t = 10)]
     checkpoint_every: u64,
@@ -113,6 +117,7 @@ pub fn run(args: TrainArgs) -> anyhow::Result<()> {
         seed: args.seed,
         val_fraction: args.val_fraction,
         best_by: args.best_by.into(),
+        objective: args.objective.into(),
         checkpoint_every: args.checkpoint_every,
     }
     .check()?;
