@@ -31,7 +31,8 @@ fn tiny_demo_evaluate_and_sweep() {
         "--seed",
         "5",
     ];
-    ok(&run);
+    let stdout = ok(&run);
+    assert!(stdout.contains("the paper beside flapssm"), "{stdout}");
 
     // summary.json: headline numbers, consistent with each other.
     let s = json(&dir.join("summary.json"));
@@ -57,7 +58,26 @@ fn tiny_demo_evaluate_and_sweep() {
         lag > 0.0 && lag < 1.0,
         "lags are within (0, 1) cycle: {lag}"
     );
-    assert_eq!(s["authority"].as_array().unwrap().len(), 10);
+    // The Fig. 5 pairs: 4 inputs on x1..x5, then x7 (2) and x8 (1) within D_x 8.
+    assert_eq!(s["authority"].as_array().unwrap().len(), 23);
+    let rows = s["paper_comparison"].as_array().unwrap();
+    let endpoints: Vec<&str> = rows
+        .iter()
+        .map(|r| r["endpoint"].as_str().unwrap())
+        .collect();
+    for needle in [
+        "C_Fx RMSE, PR-SSM",
+        "95 % error bounds",
+        "half-stroke",
+        "x7",
+        "x8",
+    ] {
+        assert!(
+            endpoints.iter().any(|e| e.contains(needle)),
+            "{needle}: {endpoints:?}"
+        );
+    }
+    assert!(!endpoints.iter().any(|e| e.contains("x10")));
     let stages: Vec<&str> = s["timings"]
         .as_array()
         .unwrap()
@@ -78,6 +98,7 @@ fn tiny_demo_evaluate_and_sweep() {
     }
     let html = std::fs::read_to_string(eval.join("report.html")).unwrap();
     assert!(html.contains("<html") && html.contains("</html>"));
+    assert!(html.contains("The paper beside flapssm"));
     assert!(html.matches("data:image/png;base64,").count() >= 9);
     let csv = std::fs::read_to_string(eval.join("trajectories.csv")).unwrap();
     assert_eq!(csv.lines().count(), 1 + 8);

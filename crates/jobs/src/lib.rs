@@ -30,6 +30,7 @@ pub mod evaluate;
 pub mod files;
 pub mod kinematics_compare;
 pub mod models;
+pub mod paper_comparison;
 pub mod predict;
 pub mod progress;
 pub mod resources;

@@ -125,6 +125,16 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
         "{} configuration, {} train / {} test trajectories",
         s.config.name, s.n_train, s.n_test
     );
+    println!("the paper beside flapssm (paper | flapssm | flapssm vs paper):");
+    for c in &s.paper_comparison {
+        println!(
+            "  {}\n      {} | {} | {}",
+            c.endpoint,
+            c.paper,
+            c.flapssm,
+            c.relation.map_or("—", |r| r.words())
+        );
+    }
     println!("outputs               {}", s.outputs.join(" "));
     println!("PR-SSM test RMSE (σ)  {}", f(&s.prssm_test_rmse));
     println!("LRQSM  test RMSE (σ)  {}", f(&s.lrqsm_test_rmse));

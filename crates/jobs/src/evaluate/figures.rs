@@ -11,10 +11,16 @@ use super::TrajectoryMetrics;
 use super::prepared::Prepared;
 use crate::error::{Result, analysis};
 use crate::models::LoadModel;
+use crate::paper_comparison::FIG3_TEST_NUMBERS;
 
-/// Up to `k` test trajectories (training ones when there is no test set), distinct families
-/// first, in dataset order.
+/// The examples of Fig. 3: on the paper's own trajectories (its 512 / 36 split, the angles of
+/// its six example test trajectories found from sample 93 on) the paper's six in its order, as
+/// many as `k` allows; else up to `k` test trajectories (training ones when there is no test
+/// set), distinct families first, in dataset order.
 pub(super) fn example_trajectories(ds: &Dataset, k: usize) -> Vec<usize> {
+    if let Some(paper) = paper_examples(ds) {
+        return paper.into_iter().take(k).collect();
+    }
     let n_train = ds.n_train.min(ds.len());
     let pool: Vec<usize> = if n_train < ds.len() {
         (n_train..ds.len()).collect()
@@ -38,6 +44,35 @@ pub(super) fn example_trajectories(ds: &Dataset, k: usize) -> Vec<usize> {
     }
     chosen.sort_unstable();
     chosen
+}
+
+/// Largest difference (rad) between a dataset's angles and the paper's for the same trajectory.
+const SAME_ANGLE_RAD: f64 = 3.5e-3;
+
+/// The paper's six example test trajectories as dataset indices, when `ds` holds the paper's
+/// trajectories in the paper's split.
+fn paper_examples(ds: &Dataset) -> Option<Vec<usize>> {
+    use flapssm_wing::trajectories::paper::{PAPER_N_TRAIN, PAPER_N_TRAJECTORIES, paper_angles};
+    if ds.len() != PAPER_N_TRAJECTORIES || ds.n_train != PAPER_N_TRAIN {
+        return None;
+    }
+    let angles = paper_angles(PAPER_N_TRAJECTORIES);
+    let s0 = flapssm_analysis::metrics::PUBLISHED_START_SAMPLE;
+    let examples: Vec<usize> = FIG3_TEST_NUMBERS
+        .iter()
+        .map(|n| PAPER_N_TRAIN + n - 1)
+        .collect();
+    // The dataset holds the angles as smoothed for differentiation (Savitzky–Golay): measured
+    // within 0.05° of the file's on the six; distinct trajectories differ by degrees.
+    let same = |i: usize| {
+        let (a, b) = (&ds.trajectories[i].euler_rad, &angles[i]);
+        a.len() == b.len()
+            && a[s0..]
+                .iter()
+                .zip(&b[s0..])
+                .all(|(x, y)| x.iter().zip(y).all(|(p, q)| (p - q).abs() < SAME_ANGLE_RAD))
+    };
+    examples.iter().all(|&i| same(i)).then_some(examples)
 }
 
 pub(super) fn example_title(ds: &Dataset, i: usize, m: &TrajectoryMetrics) -> String {
@@ -217,4 +252,30 @@ pub(super) fn draw_training(
     )
     .map_err(analysis("training RMSE figure"))?;
     Ok(true)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::progress::NoProgress;
+    use flapssm_wing::virtual_wing::SimulationConfig;
+
+    /// On the paper's trajectories the examples are the paper's six test trajectories in its
+    /// order; one changed angle and the dataset is no longer the paper's.
+    #[test]
+    fn the_paper_set_gets_the_papers_examples() {
+        let mut cfg = SimulationConfig::default();
+        cfg.wing.fidelity = flapssm_wing::virtual_wing::Fidelity::L0;
+        cfg.trajectories.n_trajectories = 548;
+        cfg.trajectories.n_train = 512;
+        let mut ds = crate::simulate::paper_dataset(&cfg, None, &NoProgress)
+            .unwrap()
+            .into_inner();
+        assert_eq!(example_trajectories(&ds, 6), [537, 525, 524, 544, 516, 543]);
+        assert_eq!(example_trajectories(&ds, 2), [537, 525]);
+        ds.trajectories[537].euler_rad[200][0] += 0.05;
+        let fallback = example_trajectories(&ds, 6);
+        assert_eq!(fallback.len(), 6);
+        assert!(fallback.iter().all(|&i| i >= 512) && fallback.windows(2).all(|w| w[0] < w[1]));
+    }
 }

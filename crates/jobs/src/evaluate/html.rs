@@ -202,7 +202,37 @@ pub(super) fn html_report(
         caption: "Fig. 4B — half-stroke averages: error vs measured value, training and test, with 95 % intervals".into(),
         path: f.f_4b,
     });
-    let mut sections = vec![Section {
+    let mut sections = Vec::new();
+    if !r.paper_comparison.is_empty() {
+        sections.push(Section {
+            heading: "The paper beside flapssm".into(),
+            paragraphs: vec![
+                "Every quantitative endpoint of Bayiz & Cheng (2021), its value as the paper states it (figure and line of the LaTeX source) and the same measure on this evaluation. The last column says where flapssm's range lies against the paper's; the definitions are in the documentation of flapssm_jobs::paper_comparison and docs/paper-comparison.md.".into(),
+            ],
+            tables: vec![Table {
+                caption: "Paper vs flapssm".into(),
+                header: ["endpoint", "source", "paper", "flapssm", "flapssm vs paper"]
+                    .iter()
+                    .map(|s| s.to_string())
+                    .collect(),
+                rows: r
+                    .paper_comparison
+                    .iter()
+                    .map(|c| {
+                        vec![
+                            c.endpoint.clone(),
+                            c.source.clone(),
+                            c.paper.clone(),
+                            c.flapssm.clone(),
+                            c.relation.map_or("—", |x| x.words()).into(),
+                        ]
+                    })
+                    .collect(),
+            }],
+            ..Default::default()
+        });
+    }
+    sections.push(Section {
         heading: "Accuracy".into(),
         paragraphs: vec![format!(
             "Errors are measured − predicted. Standardized errors use the training mean and standard deviation of each output and samples from {} on (0-based; the first {} samples are dropped). Intervals are the {}-% central percentile intervals (MATLAB prctile). Cycle averages are half-stroke means of the load coefficients over the last full stroke cycle.",
@@ -231,7 +261,7 @@ pub(super) fn html_report(
             },
         ],
         figures: accuracy_figs,
-    }];
+    });
     if let (Some((f_5a, f_5s, f_5b)), Some(latent)) =
         (f.fig5, models.iter().find(|m| m.n_latent() > 0))
     {
@@ -247,7 +277,7 @@ pub(super) fn html_report(
                 r.options.authority.bandwidth
             )],
             tables: vec![Table {
-                caption: "AoA and a_x on the output states".into(),
+                caption: "The pairs the paper reports (Fig. 5)".into(),
                 header: [
                     "input", "state", "median max |r|", "median lag (cycles)",
                     "lag IQR", "mode lag", "strong (median |r| > 0.5)",

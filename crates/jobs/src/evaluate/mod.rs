@@ -38,6 +38,7 @@ use flapssm_analysis::stats::Interval;
 use crate::error::{JobError, Result, analysis};
 use crate::files::{write_json, write_text};
 use crate::models::{LoadModel, ModelPrediction, predict_all};
+use crate::paper_comparison::{ComparisonRow, compare};
 use crate::progress::Progress;
 
 mod figures;
@@ -192,6 +193,16 @@ pub struct ModelMetrics {
     pub cycle_average_error_interval_all: Vec<Interval>,
 }
 
+/// How long one model took to predict one trajectory: the only machine-dependent numbers of
+/// [`EvaluationReport`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PredictionTiming {
+    /// The model's key.
+    pub model: String,
+    /// Median over trajectories of one prediction's wall time (ms, on one thread of the pool).
+    pub median_ms: f64,
+}
+
 impl ModelMetrics {
     /// The test metrics, or the training metrics when there is no test set.
     pub fn test_or_train(&self) -> &SplitMetrics {
@@ -268,9 +279,20 @@ pub struct EvaluationReport {
     pub rmse_ratio: Vec<f64>,
     /// Per-trajectory results.
     pub trajectories: Vec<TrajectoryMetrics>,
-    /// Influence of AoA and a_x on the output states x1..x5 of the first model with latent
-    /// states (paper: AoA near zero lag, a_x about 0.2 cycle); empty without one.
+    /// The pairs of Fig. 5 the paper reports, for the first model with latent states: AoA,
+    /// a_x, dα/dt and d²α/dt² on the output states x1..x5, d²α/dt² and dα/dt on x7, a_y on
+    /// x8, x10 and x12 (those within D_x); empty without a latent-state model.
     pub authority_findings: Vec<AuthorityFinding>,
+    /// The Fig. 3 example trajectories (dataset indices): on the paper's own trajectories the
+    /// paper's six, else test trajectories of distinct families.
+    #[serde(default)]
+    pub example_trajectories: Vec<usize>,
+    /// Every endpoint of the paper beside this evaluation's ([`crate::paper_comparison`]).
+    #[serde(default)]
+    pub paper_comparison: Vec<ComparisonRow>,
+    /// Prediction wall time per model (machine-dependent, unlike everything else here).
+    #[serde(default)]
+    pub prediction_timing: Vec<PredictionTiming>,
     /// Files written, relative to the output folder.
     pub files: Vec<String>,
 }
@@ -372,6 +394,7 @@ pub fn evaluate(
         &trajectories_csv(models, &trajectories),
     )?;
     write_predictions(&file("predictions.npz"), ds, models, &predictions)?;
+    let examples = example_trajectories(ds, opts.example_trajectories);
     let figures = draw_figures(
         ds,
         models,
@@ -380,9 +403,10 @@ pub fn evaluate(
         &trajectories,
         authority.as_ref(),
         opts,
+        &examples,
         &mut file,
     )?;
-    let report = EvaluationReport {
+    let mut report = EvaluationReport {
         version: METRICS_VERSION,
         dataset: dataset_label.to_string(),
         n_train,
@@ -392,6 +416,20 @@ pub fn evaluate(
         rmse_ratio,
         trajectories,
         authority_findings: authority.map(|a| a.findings).unwrap_or_default(),
+        example_trajectories: examples,
+        paper_comparison: Vec::new(),
+        prediction_timing: models
+            .iter()
+            .zip(&predictions)
+            .filter_map(|(m, p)| {
+                let wall: Vec<f64> = p.iter().map(|q| 1e3 * q.wall_s).collect();
+                let median_ms = flapssm_analysis::stats::median(&wall).ok()?;
+                Some(PredictionTiming {
+                    model: m.key().into(),
+                    median_ms,
+                })
+            })
+            .collect(),
         files: {
             let mut f = files.clone();
             f.retain(|f| figures.written(f));
@@ -400,6 +438,7 @@ pub fn evaluate(
             f
         },
     };
+    report.paper_comparison = compare(&report);
     write_json(&out_dir.join("metrics.json"), &report)?;
     let html = html_report(&report, context, figures, models);
     let p_html = out_dir.join("report.html");
@@ -641,21 +680,28 @@ fn authority(
         &opts.authority,
     )
     .map_err(analysis("control-authority summary"))?;
-    let mut findings = Vec::new();
-    for input in [0usize, 2] {
-        for (state, state_name) in state_names.iter().enumerate().take(5) {
+    // Inputs: 0 AoA, 2 a_x, 3 a_y, 5 dα/dt, 6 d²α/dt²; states 0-based.
+    let mut pairs: Vec<(usize, usize)> = Vec::new();
+    for input in [0usize, 2, 5, 6] {
+        pairs.extend((0..5.min(dx)).map(|state| (input, state)));
+    }
+    pairs.extend([(6, 6), (5, 6), (3, 7), (3, 9), (3, 11)]);
+    let findings = pairs
+        .into_iter()
+        .filter(|&(_, state)| state < dx)
+        .map(|(input, state)| {
             let s = summary.pair(state, input);
-            findings.push(AuthorityFinding {
+            AuthorityFinding {
                 input: input_names[input].clone(),
-                state: state_name.clone(),
+                state: state_names[state].clone(),
                 median_abs_r: s.median_abs_r,
                 median_lag_cycles: s.median_lag_cycles,
                 lag_iqr_cycles: s.lag_iqr_cycles,
                 mode_lag_cycles: s.mode_lag_cycles,
                 strong: s.strong,
-            });
-        }
-    }
+            }
+        })
+        .collect();
     Ok(Authority {
         table,
         summary,
@@ -675,11 +721,11 @@ fn draw_figures(
     trajectories: &[TrajectoryMetrics],
     authority: Option<&Authority>,
     opts: &EvalOptions,
+    examples: &[usize],
     file: &mut dyn FnMut(&str) -> PathBuf,
 ) -> Result<ReportFigures> {
     let n = ds.n_samples();
     let wing = &ds.meta.wing;
-    let examples = example_trajectories(ds, opts.example_trajectories);
     let labels: Vec<String> = examples
         .iter()
         .map(|&i| example_title(ds, i, &trajectories[i]))
@@ -701,7 +747,7 @@ fn draw_figures(
     };
     wing3d::wing_motion_3d(&f_2c, &paths, &geom).map_err(analysis("Fig. 2C"))?;
     let f_3 = file("fig3_time_histories.png");
-    draw_fig3(&f_3, ds, models, prep, &examples, &labels)?;
+    draw_fig3(&f_3, ds, models, prep, examples, &labels)?;
 
     let edges = Histogram::uniform_edges(-1.1, 1.1, 0.01);
     let out_names = OUTPUT_NAMES
@@ -878,7 +924,74 @@ mod tests {
             let w = published_window(&stroke).unwrap();
             assert_eq!((m.window_start, m.period_samples), (w.first, w.duration));
         }
-        assert_eq!(r.authority_findings.len(), 10);
+        // 4 inputs on x1..x5; with D_x 5 there is no x7..x12.
+        assert_eq!(r.authority_findings.len(), 20);
+        // The paper beside us: each endpoint from the report's own numbers.
+        let row = |prefix: &str| {
+            r.paper_comparison
+                .iter()
+                .find(|c| c.endpoint.starts_with(prefix))
+                .unwrap_or_else(|| panic!("no row {prefix}: {:#?}", r.paper_comparison))
+        };
+        let ex = &r.example_trajectories;
+        assert!(!ex.is_empty() && ex.iter().all(|&i| i >= r.n_train));
+        let cfx: Vec<f64> = ex
+            .iter()
+            .map(|&i| r.trajectories[i].models[0].cycle_rmse_cf[0])
+            .collect();
+        let (lo, hi) = (
+            cfx.iter().copied().fold(f64::INFINITY, f64::min),
+            cfx.iter().copied().fold(0.0, f64::max),
+        );
+        let fig3 = row("C_Fx RMSE, PR-SSM");
+        assert!(
+            fig3.flapssm.starts_with(&format!("{lo:.2}–{hi:.2} (")),
+            "{fig3:?}"
+        );
+        assert_eq!(fig3.paper, "0.11–0.21");
+        let bound = pt
+            .error_interval
+            .iter()
+            .map(|i| i.lo.abs().max(i.hi.abs()))
+            .fold(0.0, f64::max);
+        let fig4a = row("95 % error bounds over the 5 outputs (σ), PR-SSM, test");
+        assert!(
+            fig4a.flapssm.ends_with(&format!("–{bound:.2}")),
+            "{fig4a:?}"
+        );
+        let c = &rl.cycle_average_error_interval_all[1];
+        let fig4b = row("95 % interval of half-stroke-average C_Fy errors, LRQSM");
+        assert!(
+            fig4b
+                .flapssm
+                .starts_with(&format!("[{:.2}, {:.2}]", c.lo, c.hi))
+        );
+        assert_eq!(fig4b.paper, "[-0.20, 0.20]");
+        for prefix in [
+            "C_Fy RMSE, LRQSM",
+            "C_Fx RMSE ratio LRQSM / PR-SSM",
+            "C_Fy RMSE ratio LRQSM / PR-SSM",
+            "95 % error bounds over the 5 outputs (σ), LRQSM, training",
+            "AoA → the outputs",
+            "a_x → the outputs",
+            "d²α/dt² → the outputs",
+            "prediction of one trajectory, PR-SSM",
+        ] {
+            row(prefix);
+        }
+        assert!(
+            r.paper_comparison
+                .iter()
+                .all(|c| !c.endpoint.contains("x7"))
+        );
+        assert!(
+            r.prediction_timing
+                .iter()
+                .any(|t| t.model == "prssm" && t.median_ms > 0.0)
+        );
+        let written: EvaluationReport =
+            serde_json::from_slice(&std::fs::read(dir.join("metrics.json")).unwrap()).unwrap();
+        assert_eq!(written.paper_comparison, r.paper_comparison);
         for f in &r.files {
             assert!(dir.join(f).exists(), "{f}");
         }

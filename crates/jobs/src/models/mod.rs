@@ -138,6 +138,8 @@ pub struct ModelPrediction {
     pub var: Option<Vec<f64>>,
     /// Latent means, `n × n_latent` (empty without latent states).
     pub latent_mean: Vec<f64>,
+    /// Wall time of this trajectory's prediction (s, on one thread).
+    pub wall_s: f64,
 }
 
 /// Predicts every trajectory of `ds` with `model` (in parallel on the caller's rayon pool;
@@ -156,7 +158,9 @@ pub fn predict_all(
             mean: vec![0.0; n * 5],
             var: model.has_variance().then(|| vec![0.0; n * 5]),
             latent_mean: vec![0.0; n * model.n_latent()],
+            wall_s: 0.0,
         };
+        let start = std::time::Instant::now();
         model.predict_into(
             i,
             t,
@@ -166,6 +170,7 @@ pub fn predict_all(
                 latent_mean: (model.n_latent() > 0).then_some(&mut p.latent_mean[..]),
             },
         )?;
+        p.wall_s = start.elapsed().as_secs_f64();
         progress.advance(1);
         Ok(p)
     })
