@@ -210,6 +210,11 @@ fn tiny_demo_evaluate_and_sweep() {
     assert_eq!(lines.len(), 3);
     assert!(lines[1].starts_with("dx,6,") && lines[2].starts_with("data-size,4,"));
     assert!(table.with_extension("png").exists() && table.with_extension("json").exists());
+    let merged = json(&table.with_extension("json"));
+    let rows = merged["paper_comparison"].as_array().unwrap();
+    assert_eq!(rows.len(), 2, "{rows:?}");
+    assert!(rows[0]["flapssm"].as_str().unwrap().starts_with("6: "));
+    assert!(rows[1]["flapssm"].as_str().unwrap().starts_with("4: "));
 
     // Bad input: clear errors naming the file or value, nonzero exit.
     let o = flapssm(&[

@@ -404,17 +404,19 @@ fn authority_rows(findings: &[AuthorityFinding]) -> Vec<ComparisonRow> {
     rows
 }
 
-/// One latent dimension's result in a D_x sweep: validation/test RMSE over seeds.
+/// One swept value's result over seeds (a D_x or training-set-size sweep).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SelectionPoint {
     /// The swept value (D_x or training trajectories).
-    pub value: f64,
+    pub value: usize,
     /// Mean over seeds of the overall RMSE (σ) on the training trajectories.
     pub train_rmse: f64,
     /// Mean over seeds of the overall test RMSE (σ).
     pub test_rmse: f64,
     /// Spread (max − min) of the test RMSE over seeds.
     pub test_spread: f64,
+    /// Spread (max − min) of the training RMSE over seeds.
+    pub train_spread: f64,
     /// Seeds.
     pub seeds: usize,
 }
@@ -444,12 +446,18 @@ pub fn selection_rows(dx: &[SelectionPoint], sizes: &[SelectionPoint]) -> Vec<Co
     }
     if !sizes.is_empty() {
         rows.push(ComparisonRow {
-            endpoint: "training-set size: training / test RMSE (σ)".into(),
+            endpoint: "training-set size: training / test RMSE (σ), mean ± spread over seeds"
+                .into(),
             source: "Methods, line 95".into(),
             paper: "512 training trajectories: training and test accuracy similar".into(),
             flapssm: sizes
                 .iter()
-                .map(|p| format!("{}: {:.3} / {:.3}", p.value, p.train_rmse, p.test_rmse))
+                .map(|p| {
+                    format!(
+                        "{}: {:.3} ± {:.3} / {:.3} ± {:.3}",
+                        p.value, p.train_rmse, p.train_spread, p.test_rmse, p.test_spread
+                    )
+                })
                 .collect::<Vec<_>>()
                 .join("; "),
             relation: None,

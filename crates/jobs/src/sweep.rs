@@ -2,8 +2,9 @@
 //! per configuration so any job scheduler can spread them) and the merge of their result files
 //! into one table and figure ([`SweepTable`]).
 //!
-//! Kinds (paper defaults): latent dimension `D_x ∈ {8, 12, 16}`; training-set size (the first
-//! `V` training trajectories, e.g. {64, 128, 256, 512}). Accuracy is the open-loop RMSE of
+//! Kinds: latent dimension (the paper's `D_x ∈ {8, 12, 16}`); training-set size (the first
+//! `V` training trajectories; the paper does not give its sizes, only that 512 made training
+//! and test accuracy similar). Accuracy is the open-loop RMSE of
 //! standardized outputs (the dataset's full training statistics, so all configurations share
 //! one scale) from `start_sample` on, on the trajectories trained on and on the test set.
 
@@ -19,6 +20,7 @@ use serde::{Deserialize, Serialize};
 use crate::error::{JobError, Result};
 use crate::evaluate::prepared::pooled_errors;
 use crate::files::save_json;
+use crate::paper_comparison::{ComparisonRow, SelectionPoint, selection_rows};
 use crate::predict::predict_prssm;
 use crate::progress::Progress;
 use crate::train::{TrainingOptions, TrainingPlan, train_prssm};
@@ -47,7 +49,8 @@ impl SweepKind {
         }
     }
 
-    /// The paper's values: D_x {8, 12, 16}; training sizes {64, 128, 256, 512}.
+    /// Default values: the paper's D_x {8, 12, 16}; training sizes {64, 128, 256, 512} (a
+    /// doubling series ending at the paper's 512; the paper does not list its sizes).
     pub fn paper_values(self) -> &'static [usize] {
         match self {
             SweepKind::Dx => &[8, 12, 16],
@@ -334,6 +337,13 @@ pub struct SweepRow {
 pub struct SweepTable {
     /// Rows.
     pub rows: Vec<SweepRow>,
+    /// Per kind and value: mean and spread over seeds ([`SweepTable::selection`]).
+    #[serde(default)]
+    pub selection: Vec<(SweepKind, SelectionPoint)>,
+    /// The paper's two selections beside these results
+    /// ([`crate::paper_comparison::selection_rows`]).
+    #[serde(default)]
+    pub paper_comparison: Vec<ComparisonRow>,
 }
 
 impl SweepTable {
@@ -364,7 +374,62 @@ impl SweepTable {
             })
             .collect();
         rows.sort_by_key(|a| (a.kind, a.value, a.seed));
-        Ok(Self { rows })
+        let mut table = Self {
+            rows,
+            selection: Vec::new(),
+            paper_comparison: Vec::new(),
+        };
+        let (dx, sizes) = (
+            table.selection(SweepKind::Dx),
+            table.selection(SweepKind::DataSize),
+        );
+        table.paper_comparison = selection_rows(&dx, &sizes);
+        table.selection = dx
+            .into_iter()
+            .map(|p| (SweepKind::Dx, p))
+            .chain(sizes.into_iter().map(|p| (SweepKind::DataSize, p)))
+            .collect();
+        Ok(table)
+    }
+
+    /// Mean and spread (max − min) over seeds of the overall training and test RMSE, per value
+    /// of `kind`, ascending; values without a test set are left out.
+    pub fn selection(&self, kind: SweepKind) -> Vec<SelectionPoint> {
+        let mut values: Vec<usize> = self
+            .rows
+            .iter()
+            .filter(|r| r.kind == kind)
+            .map(|r| r.value)
+            .collect();
+        values.dedup();
+        values
+            .into_iter()
+            .filter_map(|value| {
+                let rows: Vec<&SweepRow> = self
+                    .rows
+                    .iter()
+                    .filter(|r| r.kind == kind && r.value == value)
+                    .collect();
+                let test: Vec<f64> = rows.iter().filter_map(|r| r.test_overall).collect();
+                if test.len() != rows.len() {
+                    return None;
+                }
+                let train: Vec<f64> = rows.iter().map(|r| r.train_overall).collect();
+                let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
+                let spread = |v: &[f64]| {
+                    v.iter().copied().fold(f64::NEG_INFINITY, f64::max)
+                        - v.iter().copied().fold(f64::INFINITY, f64::min)
+                };
+                Some(SelectionPoint {
+                    value,
+                    train_rmse: mean(&train),
+                    test_rmse: mean(&test),
+                    test_spread: spread(&test),
+                    train_spread: spread(&train),
+                    seeds: rows.len(),
+                })
+            })
+            .collect()
     }
 
     /// CSV text: one row per configuration.
@@ -458,5 +523,52 @@ impl SweepTable {
             })
             .collect();
         accuracy_vs_setting(path, &panels)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn row(kind: SweepKind, value: usize, seed: u64, train: f64, test: f64) -> SweepRow {
+        SweepRow {
+            kind,
+            value,
+            seed,
+            n_train: 10,
+            train_overall: train,
+            test_overall: Some(test),
+            test_rmse: None,
+            train_wall_s: 1.0,
+            source: format!("{value}-{seed}"),
+        }
+    }
+
+    /// Mean and max − min over seeds per value; the paper's two rows carry them.
+    #[test]
+    fn selection_averages_over_seeds() {
+        let table = SweepTable {
+            rows: vec![
+                row(SweepKind::Dx, 8, 0, 0.30, 0.40),
+                row(SweepKind::Dx, 8, 1, 0.34, 0.46),
+                row(SweepKind::Dx, 12, 0, 0.20, 0.30),
+                row(SweepKind::DataSize, 64, 0, 0.10, 0.50),
+            ],
+            selection: Vec::new(),
+            paper_comparison: Vec::new(),
+        };
+        let dx = table.selection(SweepKind::Dx);
+        assert_eq!(dx.len(), 2);
+        assert_eq!((dx[0].value, dx[0].seeds, dx[1].seeds), (8, 2, 1));
+        assert!((dx[0].test_rmse - 0.43).abs() < 1e-12 && (dx[0].test_spread - 0.06).abs() < 1e-12);
+        assert!((dx[0].train_rmse - 0.32).abs() < 1e-12 && dx[1].test_spread == 0.0);
+        let rows = selection_rows(&dx, &table.selection(SweepKind::DataSize));
+        assert_eq!(rows.len(), 2);
+        assert!(
+            rows[0]
+                .flapssm
+                .starts_with("8: 0.430 ± 0.060 (2 seeds); 12: 0.300")
+        );
+        assert!(rows[1].flapssm.starts_with("64: 0.100 ± 0.000 / 0.500"));
     }
 }

@@ -174,6 +174,13 @@ fn merge(a: MergeArgs) -> anyhow::Result<()> {
         .write(&a.out)
         .with_context(|| format!("writing {}", a.out.display()))?;
     print!("{}", table.to_csv());
+    if !table.paper_comparison.is_empty() {
+        println!("the paper's selections beside these results:");
+        print!(
+            "{}",
+            flapssm_jobs::paper_comparison::markdown(&table.paper_comparison)
+        );
+    }
     println!("wrote {} (+ .json, .png)", a.out.display());
     Ok(())
 }

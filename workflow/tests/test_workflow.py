@@ -1,0 +1,77 @@
+"""The Snakemake workflow of the paper's selections on its tiny configuration: every rule runs
+(simulate, one sweep run per kind × value × seed, the merge), the merged table carries the
+paper's two selection rows with the spread over seeds, a second invocation has nothing to do,
+and the Slurm profile plans the same jobs (dry run; no cluster here)."""
+
+import json
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+WORKFLOW = ROOT / "workflow"
+FLAPSSM = Path(os.environ.get("FLAPSSM", ROOT / "target" / "release" / "flapssm"))
+
+
+def snakemake(*args, cwd):
+    exe = shutil.which("snakemake", path=str(Path(sys.executable).parent)) or shutil.which(
+        "snakemake"
+    )
+    if exe is None:
+        pytest.fail("snakemake is not installed (scripts/test installs it)")
+    cmd = [
+        exe,
+        "--snakefile",
+        str(WORKFLOW / "Snakefile"),
+        "--configfile",
+        str(WORKFLOW / "config" / "tiny.yaml"),
+        "--config",
+        f"flapssm={FLAPSSM}",
+        "--directory",
+        str(cwd),
+        *args,
+    ]
+    return subprocess.run(cmd, capture_output=True, text=True, timeout=600)
+
+
+def test_tiny_workflow_runs_merges_and_resumes(tmp_path):
+    assert FLAPSSM.exists(), f"{FLAPSSM}: build it first (cargo build --release -p flapssm)"
+    r = snakemake("--profile", str(WORKFLOW / "profiles" / "local"), cwd=tmp_path)
+    assert r.returncode == 0, r.stderr[-4000:]
+    csv = (tmp_path / "results" / "selections.csv").read_text().splitlines()
+    # header + (2 D_x values + 1 size) × 2 seeds
+    assert len(csv) == 1 + 3 * 2, csv
+    assert {line.split(",")[0] for line in csv[1:]} == {"dx", "data-size"}
+    table = json.loads((tmp_path / "results" / "selections.json").read_text())
+    rows = table["paper_comparison"]
+    assert [row["source"] for row in rows] == ["Methods, line 95"] * 2
+    assert rows[0]["flapssm"].startswith("5: ") and "(2 seeds)" in rows[0]["flapssm"]
+    assert rows[1]["flapssm"].startswith("4: ")
+    assert (tmp_path / "results" / "selections.png").stat().st_size > 0
+    assert (tmp_path / "logs" / "dx" / "dx6_seed1.log").exists()
+
+    again = snakemake("--profile", str(WORKFLOW / "profiles" / "local"), cwd=tmp_path)
+    assert again.returncode == 0, again.stderr[-4000:]
+    assert "Nothing to be done" in again.stdout + again.stderr
+
+
+def test_slurm_profile_plans_the_same_jobs(tmp_path):
+    r = snakemake(
+        "--profile",
+        str(WORKFLOW / "profiles" / "slurm"),
+        "--default-resources",
+        "slurm_account=test",
+        "slurm_partition=test",
+        "--dry-run",
+        cwd=tmp_path,
+    )
+    assert r.returncode == 0, r.stderr[-4000:]
+    out = r.stdout + r.stderr
+    for rule, count in [("simulate", 1), ("sweep_run", 6), ("merge", 1)]:
+        assert any(
+            line.split()[:2] == [rule, str(count)] for line in out.splitlines()
+        ), out[-4000:]
