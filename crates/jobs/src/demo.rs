@@ -26,7 +26,7 @@ use flapssm_prssm::train::{BestBy, Checkpoint, LrSchedule};
 use flapssm_qs::{EnetOptions, LrqsmModel};
 use flapssm_wing::dataset::{OUTPUT_NAMES, ValidDataset};
 use flapssm_wing::features::FeatureSet;
-use flapssm_wing::virtual_wing::{Fidelity, SimulationConfig};
+use flapssm_wing::virtual_wing::SimulationConfig;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{JobError, Result};
@@ -62,12 +62,6 @@ pub const SUMMARY_FORMAT: &str = "flapssm-demo-summary";
 /// Target of the default configuration: PR-SSM test RMSE ≤ this × LRQSM's on every output.
 pub const RATIO_TARGET: f64 = 0.6;
 
-/// Aerodynamic fidelity of the demo's wing: L1 (unsteady low-order). On the default generator's
-/// L2 data the PR-SSM/LRQSM ratio meets [`RATIO_TARGET`] on F_x, M_y and M_z (0.56, 0.55, 0.58)
-/// but not on F_y (0.78) and M_x (0.63), whose L2 signal is mostly sensor error; on L1 data
-/// every output meets it (docs/demo.md). `flapssm demo --fidelity l2` runs the demo on L2.
-pub const DEMO_FIDELITY: Fidelity = Fidelity::L1;
-
 /// Everything that defines a demo run.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct DemoConfig {
@@ -98,12 +92,12 @@ impl DemoConfig {
     /// The default (short) configuration: 192 trajectories (179 train, 13 test, the published
     /// split ratio) of 470 samples; PR-SSM D_x 8, M 32, 10 particles, minibatches of 4 whole
     /// trajectories, Adam lr 0.05 decaying exponentially to 0.005, 1000 epochs (41 000 steps).
-    /// Measured 487 s CPU (12.2 min wall on the loaded shared 2-core machine); see docs/demo.md.
+    /// See docs/demo.md for its wall time.
     ///
-    /// The wing runs at L1 ([`DEMO_FIDELITY`]), not at the default generator's L2.
+    /// The wing is `flapssm simulate`'s default (L2, the same for every command; chosen on
+    /// physics, not on the demo's outcome).
     pub fn default_for(seed: u64) -> Self {
         let mut simulation = SimulationConfig::default();
-        simulation.wing.fidelity = DEMO_FIDELITY;
         simulation.trajectories.n_trajectories = 192;
         simulation.trajectories.n_train = flapssm_wing::trajectories::default_n_train(192);
         simulation.trajectories.seed = seed;
@@ -138,10 +132,9 @@ impl DemoConfig {
     /// trajectories (512 train, 36 test; [`TrajectorySource::Paper`]), D_x 12, M 100, 30 particles, minibatches of 16, lr 0.03, 1000 epochs; all 512
     /// training trajectories fitted (no validation hold-out: the normalization is theirs and an
     /// epoch is 32 minibatches, 32 000 steps in all) and the model of the lowest epoch-mean
-    /// training loss kept, as the authors' `best.ckpt`; the wing at [`DEMO_FIDELITY`].
+    /// training loss kept, as the authors' `best.ckpt`; the default wing (L2).
     pub fn full(seed: u64) -> Self {
         let mut simulation = SimulationConfig::default();
-        simulation.wing.fidelity = DEMO_FIDELITY;
         simulation.trajectories.seed = seed;
         Self {
             seed,
