@@ -1,7 +1,8 @@
-"""The Snakemake workflow of the paper's selections on its tiny configuration: every rule runs
-(simulate, one sweep run per kind × value × seed, the merge), the merged table carries the
-paper's two selection rows with the spread over seeds, a second invocation has nothing to do,
-and the Slurm profile plans the same jobs (dry run; no cluster here)."""
+"""The Snakemake workflow on its tiny configuration: every rule runs (simulate, one sweep run per
+kind × value × seed and their merge; one demo per seed and their merge), the merged sweep table
+carries the paper's two selection rows with the spread over seeds, the merged demos one row per
+seed and the paper's rows per seed, a second invocation has nothing to do, and the Slurm
+profile plans the same jobs (dry run; no cluster here)."""
 
 import json
 import os
@@ -54,6 +55,15 @@ def test_tiny_workflow_runs_merges_and_resumes(tmp_path):
     assert (tmp_path / "results" / "selections.png").stat().st_size > 0
     assert (tmp_path / "logs" / "dx" / "dx6_seed1.log").exists()
 
+    demos = (tmp_path / "results" / "demo_seeds.csv").read_text().splitlines()
+    assert len(demos) == 3 and demos[0].startswith("seed,prssm_F_x"), demos
+    assert [line.split(",")[0] for line in demos[1:]] == ["0", "1"]
+    summary = json.loads((tmp_path / "demos" / "seed1" / "summary.json").read_text())
+    ratio = float(demos[2].split(",")[11])
+    assert abs(ratio - summary["rmse_ratio"][0]) < 1e-12
+    md = (tmp_path / "results" / "demo_seeds.md").read_text()
+    assert "| PR-SSM |" in md and "The paper beside each seed" in md and "seed 1 |" in md
+
     again = snakemake("--profile", str(WORKFLOW / "profiles" / "local"), cwd=tmp_path)
     assert again.returncode == 0, again.stderr[-4000:]
     assert "Nothing to be done" in again.stdout + again.stderr
@@ -71,7 +81,13 @@ def test_slurm_profile_plans_the_same_jobs(tmp_path):
     )
     assert r.returncode == 0, r.stderr[-4000:]
     out = r.stdout + r.stderr
-    for rule, count in [("simulate", 1), ("sweep_run", 6), ("merge", 1)]:
+    for rule, count in [
+        ("simulate", 1),
+        ("sweep_run", 6),
+        ("merge", 1),
+        ("demo_run", 2),
+        ("demo_merge", 1),
+    ]:
         assert any(
             line.split()[:2] == [rule, str(count)] for line in out.splitlines()
         ), out[-4000:]
