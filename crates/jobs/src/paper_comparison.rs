@@ -61,18 +61,14 @@ pub const FIG4B_INTERVALS: [[[f64; 2]; 2]; 2] = [
 /// Line 118: prediction of one trajectory (s), GTX 1070 GPU + i7-7700K, TensorFlow.
 pub const PREDICTION_S: f64 = 0.25;
 
-/// A Fig. 5 finding: input, state(s), the paper's median max |r| and lag (cycles) where
-/// stated, its words, and its line.
+/// A Fig. 5 finding: input(s), state(s), the paper's words (with its median max |r| and lag
+/// in cycles where it states them), and its line. A claim about several inputs gives one row per input.
 #[derive(Debug, Clone, Copy)]
 pub struct AuthorityClaim {
-    /// Input label (as [`crate::evaluate::INPUT_LABELS`]).
-    pub input: &'static str,
+    /// Input labels (as [`crate::evaluate::INPUT_LABELS`]).
+    pub inputs: &'static [&'static str],
     /// States, 1-based (`x1..x5` are the outputs).
     pub states: &'static [usize],
-    /// Median max |r|, where stated.
-    pub abs_r: Option<f64>,
-    /// Lag in stroke cycles, where stated.
-    pub lag_cycles: Option<f64>,
     /// The paper's words.
     pub text: &'static str,
     /// Line of [`PAPER_TEX`].
@@ -82,76 +78,52 @@ pub struct AuthorityClaim {
 const OUTPUTS: &[usize] = &[1, 2, 3, 4, 5];
 
 /// Every Fig. 5 finding the text states.
-pub const FIG5_CLAIMS: [AuthorityClaim; 9] = [
+pub const FIG5_CLAIMS: [AuthorityClaim; 8] = [
     AuthorityClaim {
-        input: "AoA",
+        inputs: &["AoA"],
         states: OUTPUTS,
-        abs_r: Some(0.75),
-        lag_cycles: Some(0.0),
         text: "consistently around 0 delay and |r| 0.75",
         line: 158,
     },
     AuthorityClaim {
-        input: "a_x",
+        inputs: &["a_x"],
         states: OUTPUTS,
-        abs_r: None,
-        lag_cycles: Some(0.2),
         text: "strong, delay persistently around 20 % of the cycle",
         line: 158,
     },
     AuthorityClaim {
-        input: "dα/dt",
+        inputs: &["dα/dt", "d²α/dt²"],
         states: OUTPUTS,
-        abs_r: Some(0.75),
-        lag_cycles: None,
         text: "median |r| within [0.7, 0.8]; delays scattered",
         line: 158,
     },
     AuthorityClaim {
-        input: "d²α/dt²",
-        states: OUTPUTS,
-        abs_r: Some(0.75),
-        lag_cycles: None,
-        text: "median |r| within [0.7, 0.8]; delays scattered",
-        line: 158,
-    },
-    AuthorityClaim {
-        input: "d²α/dt²",
+        inputs: &["d²α/dt²"],
         states: &[7],
-        abs_r: Some(0.72),
-        lag_cycles: Some(0.0),
         text: "exclusive to 0 delay, median |r| 0.72",
         line: 160,
     },
     AuthorityClaim {
-        input: "dα/dt",
+        inputs: &["dα/dt"],
         states: &[7],
-        abs_r: Some(0.80),
-        lag_cycles: Some(0.211),
         text: "median |r| 0.80, tightly clustered at 21.1 % of the cycle",
         line: 160,
     },
     AuthorityClaim {
-        input: "a_y",
+        inputs: &["a_y"],
         states: &[8],
-        abs_r: None,
-        lag_cycles: Some(0.17),
         text: "delayed by 17 % of the cycle",
         line: 160,
     },
     AuthorityClaim {
-        input: "a_y",
+        inputs: &["a_y"],
         states: &[10],
-        abs_r: None,
-        lag_cycles: Some(0.095),
         text: "delayed by 9.5 % of the cycle",
         line: 160,
     },
     AuthorityClaim {
-        input: "a_y",
+        inputs: &["a_y"],
         states: &[12],
-        abs_r: None,
-        lag_cycles: Some(0.153),
         text: "delayed by 15.3 % of the cycle",
         line: 160,
     },
@@ -357,10 +329,13 @@ pub fn compare(report: &EvaluationReport) -> Vec<ComparisonRow> {
 
 fn authority_rows(findings: &[AuthorityFinding]) -> Vec<ComparisonRow> {
     let mut rows = Vec::new();
-    for claim in &FIG5_CLAIMS {
+    let per_input = FIG5_CLAIMS
+        .iter()
+        .flat_map(|c| c.inputs.iter().map(move |&input| (input, c)));
+    for (input, claim) in per_input {
         let of_claim: Vec<&AuthorityFinding> = findings
             .iter()
-            .filter(|f| f.input == claim.input)
+            .filter(|f| f.input == input)
             .filter(|f| claim.states.iter().any(|s| f.state == format!("x{s}")))
             .collect();
         if of_claim.len() != claim.states.len() {
@@ -389,14 +364,10 @@ fn authority_rows(findings: &[AuthorityFinding]) -> Vec<ComparisonRow> {
                 claim.states[0]
             )
         };
-        let mut paper = claim.text.to_string();
-        if let Some(l) = claim.lag_cycles {
-            paper = format!("{paper} [lag {l}]");
-        }
         rows.push(ComparisonRow {
-            endpoint: format!("{} → {states}: median max |r|, lag (cycles)", claim.input),
+            endpoint: format!("{input} → {states}: median max |r|, lag (cycles)"),
             source: format!("Fig. 5, line {}", claim.line),
-            paper,
+            paper: claim.text.into(),
             flapssm: format!("|r| {r:.2}, lag {lag:.3} (IQR {iqr:.3})"),
             relation: None,
         });
