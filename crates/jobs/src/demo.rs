@@ -255,7 +255,7 @@ pub struct DemoSummary {
     pub lrqsm_cycle_average_ci: Vec<Interval>,
     /// Further baselines evaluated beside the PR-SSM and the LRQSM ([`DemoConfig::baselines`]).
     pub baselines: Vec<BaselineSummary>,
-    /// AoA and a_x on the output states.
+    /// The Fig. 5 pairs the paper reports ([`EvaluationReport::authority_findings`]).
     pub authority: Vec<AuthorityFinding>,
     /// Median over the output states of AoA's median lag (cycles).
     pub aoa_median_lag_cycles: f64,
