@@ -17,7 +17,13 @@ def atomic_write(path, text):
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.")
     with os.fdopen(fd, "w") as f:
         f.write(text)
+    os.chmod(tmp, 0o644)  # mkstemp's 0600 is for the temporary only
     os.replace(tmp, path)
+
+
+def cell(text):
+    """A Markdown table cell: pipes escaped."""
+    return str(text).replace("|", "\\|")
 
 
 def merge(summaries, out_csv, out_md):
@@ -58,8 +64,9 @@ def merge(summaries, out_csv, out_md):
         cells = []
         for _, s in runs:
             rows = s.get("paper_comparison", [])
-            cells.append(rows[i]["flapssm"] if i < len(rows) and rows[i]["endpoint"] == row["endpoint"] else "—")
-        md.append(f"| {row['endpoint']} | {row['paper']} | " + " | ".join(cells) + " |")
+            same = i < len(rows) and rows[i]["endpoint"] == row["endpoint"]
+            cells.append(cell(rows[i]["flapssm"]) if same else "—")
+        md.append(f"| {cell(row['endpoint'])} | {cell(row['paper'])} | " + " | ".join(cells) + " |")
     atomic_write(out_md, "\n".join(md) + "\n")
 
 

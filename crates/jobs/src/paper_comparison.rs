@@ -437,17 +437,18 @@ pub fn selection_rows(dx: &[SelectionPoint], sizes: &[SelectionPoint]) -> Vec<Co
     rows
 }
 
-/// The rows as a Markdown table.
+/// The rows as a Markdown table (pipes in the text escaped).
 pub fn markdown(rows: &[ComparisonRow]) -> String {
+    let cell = |t: &str| t.replace('|', "\\|");
     let mut s = String::from("| endpoint | source | paper | flapssm | flapssm vs paper |\n");
     s.push_str("|---|---|---|---|---|\n");
     for r in rows {
         s.push_str(&format!(
             "| {} | {} | {} | {} | {} |\n",
-            r.endpoint,
-            r.source,
-            r.paper,
-            r.flapssm,
+            cell(&r.endpoint),
+            cell(&r.source),
+            cell(&r.paper),
+            cell(&r.flapssm),
             r.relation.map_or("—", Relation::words)
         ));
     }
@@ -457,6 +458,20 @@ pub fn markdown(rows: &[ComparisonRow]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn markdown_escapes_pipes() {
+        let row = ComparisonRow {
+            endpoint: "AoA: median max |r|".into(),
+            source: "line 158".into(),
+            paper: "|r| 0.75".into(),
+            flapssm: "|r| 0.74".into(),
+            relation: None,
+        };
+        let md = markdown(&[row]);
+        let line = md.lines().nth(2).unwrap();
+        assert_eq!(line.matches('|').count() - line.matches("\\|").count(), 6, "{line}");
+    }
 
     #[test]
     fn relation_of_ranges() {
