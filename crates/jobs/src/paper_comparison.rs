@@ -470,7 +470,11 @@ mod tests {
         };
         let md = markdown(&[row]);
         let line = md.lines().nth(2).unwrap();
-        assert_eq!(line.matches('|').count() - line.matches("\\|").count(), 6, "{line}");
+        assert_eq!(
+            line.matches('|').count() - line.matches("\\|").count(),
+            6,
+            "{line}"
+        );
     }
 
     #[test]
