@@ -59,30 +59,43 @@ fn zero(_: f64) -> (f64, f64) {
     (0.0, 0.0)
 }
 
-/// Wagner: impulsive start at α = 4°, LEV off; C_L(s)/(2π sin α) against the exact φ(s).
-#[test]
-fn wagner_step_response() {
+/// Wagner's exact indicial lift φ(s) at s semichords of travel.
+const WAGNER_TABLE: [(f64, f64); 5] = [
+    (1.0, 0.601),
+    (2.0, 0.669),
+    (4.0, 0.758),
+    (10.0, 0.875),
+    (20.0, 0.937),
+];
+/// Time step of [`impulsive_start`] (s; c = U = 1).
+const WAGNER_DT: f64 = 0.01;
+
+/// The plate (c = U = ρ = 1, pivot at the quarter chord) started impulsively at α = 4°, LEV
+/// off, for 20 semichords: (t, plate, loads) every [`WAGNER_DT`].
+fn impulsive_start() -> Vec<(f64, PlateState, SectionLoads)> {
     fn alpha(_: f64) -> (f64, f64) {
         (4f64.to_radians(), 0.0)
     }
-    let (c, u, rho) = (1.0, 1.0, 1.0);
-    let m = Motion { u, alpha, h: zero };
-    let dt = 0.01;
-    let n = (20.5 / (2.0 * u / c) / dt) as usize + 2;
-    let mut p = LdvmParams::inviscid(c, u, n + 10);
-    p.rho_kg_m3 = rho;
+    let m = Motion {
+        u: 1.0,
+        alpha,
+        h: zero,
+    };
+    let n = (20.5 / 2.0 / WAGNER_DT) as usize + 2;
+    let mut p = LdvmParams::inviscid(1.0, 1.0, n + 10);
+    p.rho_kg_m3 = 1.0;
     p.pivot_frac = 0.25;
     p.core_radius_frac = 0.005;
-    let (_, out) = run(p, &m, dt, n);
+    run(p, &m, WAGNER_DT, n).1
+}
+
+/// Wagner: impulsive start at α = 4°, LEV off; C_L(s)/(2π sin α) against the exact φ(s).
+#[test]
+fn wagner_step_response() {
+    let out = impulsive_start();
+    let (c, u, rho, dt) = (1.0, 1.0, 1.0, WAGNER_DT);
     let cl_inf = 2.0 * PI * 4f64.to_radians().sin();
-    let table = [
-        (1.0, 0.601),
-        (2.0, 0.669),
-        (4.0, 0.758),
-        (10.0, 0.875),
-        (20.0, 0.937),
-    ];
-    for (s, phi) in table {
+    for (s, phi) in WAGNER_TABLE {
         let t = s * c / (2.0 * u);
         let k = (t / dt).floor() as usize;
         let frac = t / dt - k as f64;
@@ -1055,27 +1068,10 @@ fn study_wake_capture_paper() {
 /// within 0.010 and D/S∞ within 0.012 at s = 1…20 semichords.
 #[test]
 fn leading_edge_suction_follows_wagner_squared() {
-    fn alpha(_: f64) -> (f64, f64) {
-        (4f64.to_radians(), 0.0)
-    }
-    let (c, u, rho) = (1.0, 1.0, 1.0);
-    let m = Motion { u, alpha, h: zero };
-    let dt = 0.01;
-    let n = (20.5 / (2.0 * u / c) / dt) as usize + 2;
-    let mut p = LdvmParams::inviscid(c, u, n + 10);
-    p.rho_kg_m3 = rho;
-    p.pivot_frac = 0.25;
-    p.core_radius_frac = 0.005;
-    let (_, out) = run(p, &m, dt, n);
-    let s_inf = rho * PI * c * u * u * 4f64.to_radians().sin().powi(2);
-    for (s, phi) in [
-        (1.0, 0.601),
-        (2.0, 0.669),
-        (4.0, 0.758),
-        (10.0, 0.875),
-        (20.0, 0.937),
-    ] {
-        let k = (s * c / (2.0 * u) / dt).round() as usize;
+    let out = impulsive_start();
+    let s_inf = PI * 4f64.to_radians().sin().powi(2);
+    for (s, phi) in WAGNER_TABLE {
+        let k = (s / 2.0 / WAGNER_DT).round() as usize;
         let (loads, plate) = (&out[k].2, &out[k].1);
         let suction = -loads.chord_n_m / s_inf;
         let drag = lift_drag(loads, plate.angle_rad).1 / s_inf;
