@@ -257,7 +257,11 @@ fn the_published_code_objective_is_selectable_and_recorded() {
 
     let ckpt = dir.path().join("p.ckpt.json");
     let out = dir.path().join("q.json");
-    let mut args = train_args(&data, &out, "1");
-    args.extend(["--val-fraction", "0", "--resume", "--checkpoint", s(&ckpt)]);
-    assert_fails(&flapssm(&args), &["run_context.fit"], &out);
+    // A larger budget too: the refusal is the first thing said (regression: "extending the
+    // run …" used to be printed before the checkpoint's configuration was checked).
+    for epochs in ["1", "2"] {
+        let mut args = train_args(&data, &out, epochs);
+        args.extend(["--val-fraction", "0", "--resume", "--checkpoint", s(&ckpt)]);
+        assert_fails(&flapssm(&args), &["run_context.fit"], &out);
+    }
 }

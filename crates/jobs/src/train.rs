@@ -300,6 +300,11 @@ pub fn train_prssm(
             "warning: step {step} rejected ({reason}); step undone, learning-rate factor now \
              {lr_scale:.3e} (retry {retry})"
         )),
+        TrainEvent::Resumed { step, checkpoint } => {
+            if let Some(note) = extension_note(checkpoint, &s.train, *step) {
+                progress.println(&note);
+            }
+        }
         TrainEvent::Interrupted { step } => progress.println(&format!(
             "interrupted at step {step}; checkpoint {}",
             checkpoint.map_or("(none)".into(), |p| p.display().to_string())
@@ -437,11 +442,6 @@ pub fn train_dataset(
         None
     };
     progress.start("train PR-SSM", 0);
-    if let Some(ck) = &resume
-        && let Some(note) = extension_note(&ck.config, &plan.spec.train, ck.state.step)
-    {
-        progress.println(&note);
-    }
     let out = train_prssm(
         ds.train(),
         plan,

@@ -177,6 +177,14 @@ pub enum TrainEvent<'a> {
         /// Steps done.
         step: u64,
     },
+    /// A checkpoint was accepted for resuming (its configuration matches this run's, the
+    /// budget aside); emitted once, before the first step.
+    Resumed {
+        /// Steps done in the checkpoint.
+        step: u64,
+        /// The checkpoint's configuration (its budget may be smaller than this run's).
+        checkpoint: &'a TrainConfig,
+    },
     /// Training stopped early on request; the state was checkpointed if a path was given.
     Interrupted {
         /// Steps done.
@@ -432,6 +440,7 @@ pub fn train<O: Objective + ?Sized>(
     let plan = BatchPlan::new(seq_lens, config.windows, config.batch_size)?;
     let bpe = plan.batches_per_epoch() as u64;
     let total_steps = config.total_steps(plan.batches_per_epoch());
+    let mut resumed_from = None;
     let mut state = match resume {
         Some(ck) => {
             // Only the budget may grow: the run is then extended from where it stopped.
@@ -457,6 +466,7 @@ pub fn train<O: Objective + ?Sized>(
                     why: format!("{} values, the objective has {n}", ck.state.params.len()),
                 });
             }
+            resumed_from = Some(ck.config);
             ck.state
         }
         None => {
@@ -492,6 +502,12 @@ pub fn train<O: Objective + ?Sized>(
             p(ev);
         }
     };
+    if let Some(checkpoint) = &resumed_from {
+        emit(&TrainEvent::Resumed {
+            step: state.step,
+            checkpoint,
+        });
+    }
     let save = |state: &TrainState| -> Result<(), TrainError> {
         if let Some(path) = &checkpoint {
             Checkpoint {
