@@ -8,7 +8,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 use flapssm_prssm::train::{
     BestBy, Budget, Checkpoint, DivergenceGuard, Evaluation, LrSchedule, TrainConfig, TrainError,
-    TrainEvent, TrainHooks, WindowSpec, train,
+    TrainEvent, TrainHooks, TrainOutcome, WindowSpec, train,
 };
 use flapssm_prssm::{Objective, ObjectiveError, Window};
 use rand::{Rng, SeedableRng};
@@ -212,6 +212,15 @@ fn minibatch_adam_with_cosine_decay_reaches_the_newton_optimum() {
     for (a, b) in out.last_params().iter().zip(&w_star) {
         assert!((a - b).abs() < 5e-3, "trained {a} vs Newton {b}");
     }
+}
+
+/// Trains `obj` on one 3-step sequence from zero parameters (no checkpoint).
+fn train_from_zero(
+    obj: &NoisyQuadratic,
+    config: &TrainConfig,
+    hooks: TrainHooks<'_>,
+) -> Result<TrainOutcome, TrainError> {
+    train(obj, &[3], &[0.0; 3], config, hooks, None)
 }
 
 fn noisy() -> NoisyQuadratic {
@@ -422,16 +431,13 @@ fn divergent_learning_rate_is_rejected_reduced_and_recovered() {
                 .push(format!("step {step}: {reason}; lr scale {lr_scale}"));
         }
     };
-    let out = train(
+    let out = train_from_zero(
         &obj,
-        &[3],
-        &[0.0; 3],
         &config,
         TrainHooks {
             progress: Some(&mut on_event),
             ..TrainHooks::default()
         },
-        None,
     )
     .unwrap();
     let messages = messages.into_inner();
@@ -460,16 +466,13 @@ fn divergent_learning_rate_is_rejected_reduced_and_recovered() {
             rejected += 1;
         }
     };
-    let out = train(
+    let out = train_from_zero(
         &obj,
-        &[3],
-        &[0.0; 3],
         &config,
         TrainHooks {
             progress: Some(&mut on_event),
             ..TrainHooks::default()
         },
-        None,
     )
     .unwrap();
     assert!(rejected > 0);
@@ -612,16 +615,13 @@ fn the_best_model_follows_the_chosen_criterion() {
                 ..Evaluation::default()
             })
         };
-        let out = train(
+        let out = train_from_zero(
             &obj,
-            &[3],
-            &[0.0; 3],
             &config,
             TrainHooks {
                 evaluate: Some(&mut evaluate),
                 ..TrainHooks::default()
             },
-            None,
         )
         .unwrap();
         let best = out.state.best.unwrap();
