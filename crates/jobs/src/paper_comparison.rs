@@ -21,7 +21,9 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::evaluate::{AuthorityFinding, EvaluationReport, ModelMetrics};
+use flapssm_analysis::stats::median;
+
+use crate::evaluate::{AuthorityFinding, EvaluationReport};
 
 /// The paper's LaTeX source, for the `source` column.
 pub const PAPER_TEX: &str = "shared/paper/bayiz-cheng-2021-state-space-aero-model.tex";
@@ -129,6 +131,16 @@ pub const FIG5_CLAIMS: [AuthorityClaim; 8] = [
     },
 ];
 
+/// The (input label, 1-based state) pairs of every Fig. 5 claim, in the claims' order: the
+/// pairs an evaluation reports ([`crate::evaluate::EvaluationReport::authority_findings`]).
+pub fn fig5_pairs() -> impl Iterator<Item = (&'static str, usize)> {
+    FIG5_CLAIMS.iter().flat_map(|c| {
+        c.inputs
+            .iter()
+            .flat_map(move |&input| c.states.iter().map(move |&state| (input, state)))
+    })
+}
+
 /// Where flapssm's value lies against the paper's range.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -202,12 +214,9 @@ fn min_max(v: impl IntoIterator<Item = f64>) -> Option<[f64; 2]> {
 /// are found by their keys (`prssm`, `lrqsm`); rows of a missing model are left out.
 pub fn compare(report: &EvaluationReport) -> Vec<ComparisonRow> {
     let mut rows = Vec::new();
-    let prssm = report.model("prssm");
-    let lrqsm = report.model("lrqsm");
-    let keyed = |m: Option<&ModelMetrics>| {
-        m.and_then(|m| report.models.iter().position(|x| x.key == m.key))
-    };
-    let (kp, kl) = (keyed(prssm), keyed(lrqsm));
+    let index = |key: &str| report.models.iter().position(|m| m.key == key);
+    let (kp, kl) = (index("prssm"), index("lrqsm"));
+    let (prssm, lrqsm) = (report.model("prssm"), report.model("lrqsm"));
     let ex = &report.example_trajectories;
     let per_example = |k: usize, c: usize| -> Vec<f64> {
         ex.iter()
@@ -342,14 +351,8 @@ fn authority_rows(findings: &[AuthorityFinding]) -> Vec<ComparisonRow> {
             continue;
         }
         let med = |get: fn(&AuthorityFinding) -> f64| {
-            let mut v: Vec<f64> = of_claim.iter().map(|f| get(f)).collect();
-            v.sort_by(f64::total_cmp);
-            let n = v.len();
-            if n % 2 == 1 {
-                v[n / 2]
-            } else {
-                0.5 * (v[n / 2 - 1] + v[n / 2])
-            }
+            let v: Vec<f64> = of_claim.iter().map(|f| get(f)).collect();
+            median(&v).unwrap_or(f64::NAN)
         };
         let (r, lag, iqr) = (
             med(|f| f.median_abs_r),
@@ -475,6 +478,17 @@ mod tests {
             6,
             "{line}"
         );
+    }
+
+    /// Every Fig. 5 input is one the evaluation knows, and the pairs cover each claim.
+    #[test]
+    fn fig5_pairs_name_known_inputs() {
+        let pairs: Vec<_> = fig5_pairs().collect();
+        assert_eq!(pairs.len(), 4 * 5 + 2 + 3);
+        for (input, state) in pairs {
+            assert!(crate::evaluate::INPUT_LABELS.contains(&input), "{input}");
+            assert!((1..=12).contains(&state));
+        }
     }
 
     #[test]

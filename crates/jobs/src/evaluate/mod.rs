@@ -38,7 +38,7 @@ use flapssm_analysis::stats::Interval;
 use crate::error::{JobError, Result, analysis};
 use crate::files::{write_json, write_text};
 use crate::models::{LoadModel, ModelPrediction, predict_all};
-use crate::paper_comparison::{ComparisonRow, compare};
+use crate::paper_comparison::{ComparisonRow, compare, fig5_pairs};
 use crate::progress::Progress;
 
 mod figures;
@@ -680,26 +680,20 @@ fn authority(
         &opts.authority,
     )
     .map_err(analysis("control-authority summary"))?;
-    // Inputs: 0 AoA, 2 a_x, 3 a_y, 5 dα/dt, 6 d²α/dt²; states 0-based.
-    let mut pairs: Vec<(usize, usize)> = Vec::new();
-    for input in [0usize, 2, 5, 6] {
-        pairs.extend((0..5.min(dx)).map(|state| (input, state)));
-    }
-    pairs.extend([(6, 6), (5, 6), (3, 7), (3, 9), (3, 11)]);
-    let findings = pairs
-        .into_iter()
-        .filter(|&(_, state)| state < dx)
-        .map(|(input, state)| {
-            let s = summary.pair(state, input);
-            AuthorityFinding {
+    let findings = fig5_pairs()
+        .filter(|&(_, state)| state <= dx)
+        .filter_map(|(label, state)| {
+            let input = INPUT_LABELS.iter().position(|l| *l == label)?;
+            let s = summary.pair(state - 1, input);
+            Some(AuthorityFinding {
                 input: input_names[input].clone(),
-                state: state_names[state].clone(),
+                state: state_names[state - 1].clone(),
                 median_abs_r: s.median_abs_r,
                 median_lag_cycles: s.median_lag_cycles,
                 lag_iqr_cycles: s.lag_iqr_cycles,
                 mode_lag_cycles: s.mode_lag_cycles,
                 strong: s.strong,
-            }
+            })
         })
         .collect();
     Ok(Authority {
