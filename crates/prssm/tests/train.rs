@@ -639,3 +639,26 @@ fn the_best_model_follows_the_chosen_criterion() {
     assert_eq!(best, lowest_loss);
     assert!(best > 10, "best epoch {best}");
 }
+
+/// The bindings' spellings of the best-model rule and the objective's form.
+#[test]
+fn best_by_and_objective_parse_from_their_names() {
+    use flapssm_prssm::train::fit::ObjectiveForm;
+    assert_eq!("rmse".parse::<BestBy>(), Ok(BestBy::Rmse));
+    assert_eq!("training-loss".parse::<BestBy>(), Ok(BestBy::TrainingLoss));
+    assert!(
+        "lowest"
+            .parse::<BestBy>()
+            .unwrap_err()
+            .contains("rmse or training-loss")
+    );
+    assert_eq!(
+        "standard".parse::<ObjectiveForm>(),
+        Ok(ObjectiveForm::Standard)
+    );
+    assert_eq!(
+        "published-code".parse::<ObjectiveForm>(),
+        Ok(ObjectiveForm::PublishedCode)
+    );
+    assert!("published_code".parse::<ObjectiveForm>().is_err());
+}

@@ -239,24 +239,12 @@ pub fn train(
     best_by: &str,
     objective: &str,
 ) -> PyResult<Prssm> {
-    let best_by = match best_by {
-        "rmse" => flapssm_prssm::train::BestBy::Rmse,
-        "training-loss" => flapssm_prssm::train::BestBy::TrainingLoss,
-        other => {
-            return Err(PyValueError::new_err(format!(
-                "best_by = {other:?}: expected \"rmse\" or \"training-loss\""
-            )));
-        }
-    };
-    let objective = match objective {
-        "standard" => flapssm_prssm::train::fit::ObjectiveForm::Standard,
-        "published-code" => flapssm_prssm::train::fit::ObjectiveForm::PublishedCode,
-        other => {
-            return Err(PyValueError::new_err(format!(
-                "objective = {other:?}: expected \"standard\" or \"published-code\""
-            )));
-        }
-    };
+    let best_by: flapssm_prssm::train::BestBy = best_by
+        .parse()
+        .map_err(|e: String| PyValueError::new_err(format!("best_by: {e}")))?;
+    let objective: flapssm_prssm::train::fit::ObjectiveForm = objective
+        .parse()
+        .map_err(|e: String| PyValueError::new_err(format!("objective: {e}")))?;
     let plan = TrainingOptions {
         preset: preset
             .parse()

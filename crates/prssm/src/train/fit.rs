@@ -81,6 +81,20 @@ pub enum ObjectiveForm {
     PublishedCode,
 }
 
+impl std::str::FromStr for ObjectiveForm {
+    type Err = String;
+    /// `standard` or `published-code` (the command line's and the bindings' spelling).
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "standard" => Ok(ObjectiveForm::Standard),
+            "published-code" => Ok(ObjectiveForm::PublishedCode),
+            _ => Err(format!(
+                "unknown form {s:?} (expected standard or published-code)"
+            )),
+        }
+    }
+}
+
 /// Everything that defines a fit.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct FitSpec {

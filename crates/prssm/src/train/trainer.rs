@@ -78,6 +78,20 @@ pub enum BestBy {
     TrainingLoss,
 }
 
+impl std::str::FromStr for BestBy {
+    type Err = String;
+    /// `rmse` or `training-loss` (the command line's and the bindings' spelling).
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "rmse" => Ok(BestBy::Rmse),
+            "training-loss" => Ok(BestBy::TrainingLoss),
+            _ => Err(format!(
+                "unknown rule {s:?} (expected rmse or training-loss)"
+            )),
+        }
+    }
+}
+
 /// Configuration of a training run (all of it is stored in checkpoints).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct TrainConfig {
