@@ -9,6 +9,7 @@ use std::path::Path;
 use std::process::{Command, Stdio};
 
 use common::{assert_fails, flapssm, json, ok, s, simulated};
+use flapssm_jobs::curve::read_curve;
 use flapssm_prssm::PrssmModel;
 
 const EPOCHS: &str = "60";
@@ -99,6 +100,31 @@ fn ctrl_c_then_resume_is_bit_identical_and_the_model_predicts() {
     }
     let history = json(&b)["model"]["training"]["history"].clone();
     assert_eq!(history.as_array().unwrap().len(), 60);
+    // The learning curve beside the model: one row per evaluated epoch, the resumed run's
+    // rows continuing the interrupted one's (same epochs, steps and RMSEs as the
+    // uninterrupted run, wall time never going back).
+    let curve_a = read_curve(&dir.path().join("a.curve.csv")).unwrap();
+    let curve_b = read_curve(&dir.path().join("b.curve.csv")).unwrap();
+    assert_eq!(curve_b.len(), 60);
+    for (k, (pa, pb)) in curve_a.iter().zip(&curve_b).enumerate() {
+        assert_eq!((pa.epoch, pa.step), (pb.epoch, pb.step));
+        assert_eq!(pa.val_rmse.to_bits(), pb.val_rmse.to_bits());
+        assert_eq!(pb.val_rmse, history[k]["val_rmse"].as_f64().unwrap());
+    }
+    assert!(curve_b.windows(2).all(|w| w[1].wall_s >= w[0].wall_s));
+    let ttq = ok(&[
+        "bench",
+        "--batches",
+        "1",
+        "--reps",
+        "1",
+        "--train",
+        s(&dir.path().join("b.curve.csv")),
+    ]);
+    assert!(
+        ttq.contains("time to quality") && ttq.contains("reached at epoch"),
+        "{ttq}"
+    );
 
     let model = PrssmModel::load(&b).unwrap();
     assert_eq!(
@@ -264,4 +290,75 @@ fn the_published_code_objective_is_selectable_and_recorded() {
         args.extend(["--val-fraction", "0", "--resume", "--checkpoint", s(&ckpt)]);
         assert_fails(&flapssm(&args), &["run_context.fit"], &out);
     }
+}
+
+/// `--inducing-init kmeans` starts `Z` on the training inputs, is recorded in the model file,
+/// and a bad value is refused naming the choices.
+#[test]
+fn the_inducing_start_is_selectable_and_recorded() {
+    let dir = tempfile::tempdir().unwrap();
+    let data = simulated(dir.path(), 3, 4);
+    let start_of = |rule: &str| {
+        let out = dir.path().join(format!("{rule}.json"));
+        let mut args = train_args(&data, &out, "1");
+        args.extend([
+            "--inducing-init",
+            rule,
+            "--val-fraction",
+            "0",
+            "--lr",
+            "1e-9",
+        ]);
+        ok(&args);
+        let model = json(&out)["model"].clone();
+        assert_eq!(model["training"]["spec"]["inducing_init"], rule);
+        let z: Vec<f64> = model["params"]["inducing_inputs"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap())
+            .collect();
+        z
+    };
+    // With a learning rate of 1e-9 the trained Z is its start: the two starts differ, and
+    // the k-means start is seeded (a second run gives it again).
+    let (uniform, kmeans) = (start_of("uniform"), start_of("kmeans"));
+    assert_ne!(uniform, kmeans);
+    assert_eq!(kmeans, start_of("kmeans"));
+    let refused = dir.path().join("x.json");
+    let mut args = train_args(&data, &refused, "1");
+    args.extend(["--inducing-init", "random"]);
+    let out = flapssm(&args);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("kmeans") && err.contains("uniform"), "{err}");
+}
+
+/// `--patience N` ends the run once N evaluated epochs in a row bring no new best model, and
+/// says so; the model files are written as for a whole run.
+#[test]
+fn patience_stops_training_early_and_says_so() {
+    let dir = tempfile::tempdir().unwrap();
+    let data = simulated(dir.path(), 6, 5);
+    let out = dir.path().join("p.json");
+    let mut args = train_args(&data, &out, "60");
+    args.extend(["--patience", "2", "--lr", "0.3"]);
+    let o = flapssm(&args);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("stopped early at step"), "{err}");
+    let history = json(&out)["model"]["training"]["history"].clone();
+    let h = history.as_array().unwrap();
+    assert!(h.len() < 60);
+    assert!(h[h.len() - 2..].iter().all(|r| r["is_best"] == false));
+    assert_eq!(
+        read_curve(&dir.path().join("p.curve.csv")).unwrap().len(),
+        h.len()
+    );
+    let mut zero = train_args(&data, &out, "60");
+    zero.extend(["--patience", "0"]);
+    let o = flapssm(&zero);
+    assert!(!o.status.success());
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("--patience"), "{err}");
 }

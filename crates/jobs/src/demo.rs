@@ -29,6 +29,7 @@ use flapssm_wing::features::FeatureSet;
 use flapssm_wing::virtual_wing::SimulationConfig;
 use serde::{Deserialize, Serialize};
 
+use crate::curve::CurveRecorder;
 use crate::error::{JobError, Result};
 use crate::evaluate::{
     AuthorityFinding, EvalOptions, EvaluationReport, METRICS_VERSION, ReportContext, evaluate,
@@ -47,13 +48,14 @@ use flapssm_analysis::stats::{Interval, median};
 /// The files [`run_demo`] writes in its output folder, besides `eval/`
 /// ([`crate::evaluate::EVALUATION_FILES`]); checked before any work by
 /// [`crate::files::check_output_dir`].
-pub const DEMO_FILES: [&str; 7] = [
+pub const DEMO_FILES: [&str; 8] = [
     "stages.json",
     "dataset.npz",
     "lrqsm.json",
     "prssm.json",
     "prssm.last.json",
     "prssm.ckpt.json",
+    "prssm.curve.csv",
     "summary.json",
 ];
 
@@ -439,6 +441,7 @@ pub fn run_demo(
     let pm_path = dir.join("prssm.json");
     let last_path = dir.join("prssm.last.json");
     let ck_path = dir.join("prssm.ckpt.json");
+    let curve_path = dir.join("prssm.curve.csv");
     let k_pm = serde_json::json!({ "upstream": k_sim, "training": json(&cfg.training) });
     let started_key = "prssm (started)";
     let prssm = {
@@ -480,7 +483,17 @@ pub fn run_demo(
                 if !note.is_empty() {
                     p.println(&note);
                 }
-                let out = train_prssm(ds.train(), &plan, Some(&ck_path), resume, p, stop)?;
+                let mut curve =
+                    CurveRecorder::new(&curve_path, resume.as_ref().map(|c| c.state.step))?;
+                let out = train_prssm(
+                    ds.train(),
+                    &plan,
+                    Some(&ck_path),
+                    resume,
+                    Some(&mut curve),
+                    p,
+                    stop,
+                )?;
                 for (m, path) in [(&out.best, &pm_path), (&out.last, &last_path)] {
                     m.save(path).map_err(|source| JobError::ModelFile {
                         path: path.clone(),

@@ -15,6 +15,7 @@
 //! | [`sweep`] | one-configuration PR-SSM sweep runs (D_x, training-set size) and their merge |
 //! | [`demo`] | the one-command demo: simulate, fit, train, evaluate (resumable) |
 //! | [`bench`](mod@bench) | the engine's speed in the paper's configuration beside the authors' code |
+//! | [`curve`] | learning curves with wall times, and the time-to-quality read from them |
 //! | [`sysid`] | Doerr et al. system-identification protocol (fit, open-loop test, RMSE/NLL) |
 //!
 //! Shared pieces: [`error`] (one error type naming the file, trajectory or stage), [`progress`]
@@ -24,6 +25,7 @@
 #![warn(missing_docs)]
 
 pub mod bench;
+pub mod curve;
 pub mod demo;
 pub mod error;
 pub mod evaluate;

@@ -231,7 +231,7 @@ pub fn sweep_run(
     let (n_fit, n_val) = (fit_set.len(), val_set.len());
     progress.start(&format!("train {} = {value}", kind.name()), 0);
     let t0 = Instant::now();
-    let out = train_prssm(train, plan, None, None, progress, stop)?;
+    let out = train_prssm(train, plan, None, None, None, progress, stop)?;
     let train_wall_s = t0.elapsed().as_secs_f64();
     progress.finish("");
 

@@ -6,10 +6,13 @@ use std::sync::atomic::AtomicBool;
 
 use flapssm_prssm::SequenceView;
 use flapssm_prssm::train::fit::{FitError, FitOutcome, FitSpec, ObjectiveForm, Preset, fit};
-use flapssm_prssm::train::{BestBy, Budget, Checkpoint, LrSchedule, TrainEvent, TrainHooks};
+use flapssm_prssm::train::{
+    BestBy, Budget, Checkpoint, InducingInit, LrSchedule, TrainEvent, TrainHooks,
+};
 use flapssm_wing::dataset::{Trajectory, ValidDataset};
 use serde::{Deserialize, Serialize};
 
+use crate::curve::CurveRecorder;
 use crate::error::{JobError, Result};
 use crate::predict::trajectory_sequence;
 use crate::progress::Progress;
@@ -48,6 +51,12 @@ pub struct TrainingOptions {
     /// The training objective: the standard ELBO or the published code's (both quirks).
     #[serde(default)]
     pub objective: ObjectiveForm,
+    /// How the inducing inputs and `q(u)` means start (the preset's when `None`).
+    #[serde(default)]
+    pub inducing_init: Option<InducingInit>,
+    /// Early stopping: end when this many evaluated epochs in a row bring no new best model.
+    #[serde(default)]
+    pub patience: Option<u64>,
     /// Checkpoint every this many epochs (0: only when interrupted).
     pub checkpoint_every: u64,
 }
@@ -70,6 +79,8 @@ impl Default for TrainingOptions {
             val_fraction: 0.1,
             best_by: BestBy::Rmse,
             objective: ObjectiveForm::Standard,
+            inducing_init: None,
+            patience: None,
             checkpoint_every: 10,
         }
     }
@@ -106,6 +117,12 @@ impl TrainingOptions {
         }
         if let Some(v) = self.eval_every {
             spec.train.eval_every = v;
+        }
+        if let Some(v) = self.inducing_init {
+            spec.inducing_init = v;
+        }
+        if self.patience.is_some() {
+            spec.train.patience = self.patience;
         }
         spec.train.seed = self.seed;
         spec.train.checkpoint_every = self.checkpoint_every;
@@ -147,6 +164,7 @@ impl TrainingOptions {
             ("epochs", self.epochs),
             ("iterations", self.iterations),
             ("eval_every", self.eval_every),
+            ("patience", self.patience),
         ] {
             if v == Some(0) {
                 return bad(name, "0".into(), "must be at least 1");
@@ -241,7 +259,8 @@ impl TrainingPlan {
 
 /// Trains a PR-SSM on `train` (split by [`TrainingPlan::split`]), reporting steps to
 /// `progress` (`set(step, total)`, one line per evaluated epoch, rejected step, checkpoint),
-/// checkpointing to `checkpoint` and resuming from `resume`. Polls `stop` before every step.
+/// recording evaluated epochs to `curve`, checkpointing to `checkpoint` and resuming from
+/// `resume`. Polls `stop` before every step.
 ///
 /// # Errors
 /// [`JobError::Prssm`] for a failed fit, [`JobError::Interrupted`] when stopped (the
@@ -251,6 +270,7 @@ pub fn train_prssm(
     plan: &TrainingPlan,
     checkpoint: Option<&Path>,
     resume: Option<Checkpoint>,
+    curve: Option<&mut CurveRecorder>,
     progress: &dyn Progress,
     stop: Option<&AtomicBool>,
 ) -> Result<FitOutcome> {
@@ -269,6 +289,8 @@ pub fn train_prssm(
     )?;
     let fit_seqs: Vec<SequenceView<'_>> = fit_set.iter().map(trajectory_sequence).collect();
     let val_seqs: Vec<SequenceView<'_>> = val_set.iter().map(trajectory_sequence).collect();
+    let mut curve = curve;
+    let mut curve_error = None;
     let mut on_event = |e: &TrainEvent<'_>| match e {
         TrainEvent::Step {
             step,
@@ -281,6 +303,11 @@ pub fn train_prssm(
             progress.message(&format!("epoch {epoch} loss {loss:.4e} lr {lr:.2e}"));
         }
         TrainEvent::Epoch(r) => {
+            if let Some(c) = curve.as_mut()
+                && let Err(e) = c.record(r)
+            {
+                curve_error.get_or_insert(e);
+            }
             let f = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.4}"));
             progress.println(&format!(
                 "epoch {:>4}: -ELBO {:.4e}  train RMSE {}  val RMSE {}{}",
@@ -327,6 +354,17 @@ pub fn train_prssm(
         what: "training".into(),
         source,
     })?;
+    if let Some(e) = curve_error {
+        return Err(e);
+    }
+    if out.outcome.early_stopped {
+        progress.println(&format!(
+            "stopped early at step {} of {}: no new best model for {} evaluated epochs",
+            out.outcome.state.step,
+            out.outcome.total_steps,
+            s.train.patience.unwrap_or(0)
+        ));
+    }
     if out.outcome.interrupted {
         return Err(JobError::Interrupted {
             step: out.outcome.state.step,
@@ -380,15 +418,19 @@ pub struct TrainFiles {
     pub last: PathBuf,
     /// Checkpoint (written every `checkpoint_every` epochs and when stopped).
     pub checkpoint: PathBuf,
+    /// Learning curve, one row per evaluated epoch with its wall time ([`crate::curve`]).
+    pub curve: PathBuf,
 }
 
 impl TrainFiles {
-    /// `model`, `<stem>.last.json` beside it, and `checkpoint` or `<stem>.ckpt.json`.
+    /// `model`, `<stem>.last.json` and `<stem>.curve.csv` beside it, and `checkpoint` or
+    /// `<stem>.ckpt.json`.
     pub fn beside(model: &Path, checkpoint: Option<PathBuf>) -> Self {
         Self {
             model: model.to_path_buf(),
             last: sibling(model, ".last.json"),
             checkpoint: checkpoint.unwrap_or_else(|| sibling(model, ".ckpt.json")),
+            curve: sibling(model, ".curve.csv"),
         }
     }
 }
@@ -441,12 +483,14 @@ pub fn train_dataset(
     } else {
         None
     };
+    let mut curve = CurveRecorder::new(&files.curve, resume.as_ref().map(|c| c.state.step))?;
     progress.start("train PR-SSM", 0);
     let out = train_prssm(
         ds.train(),
         plan,
         Some(&files.checkpoint),
         resume,
+        Some(&mut curve),
         progress,
         stop,
     )?;

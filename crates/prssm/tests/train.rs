@@ -662,3 +662,67 @@ fn best_by_and_objective_parse_from_their_names() {
     );
     assert!("published_code".parse::<ObjectiveForm>().is_err());
 }
+
+/// Early stopping ends the run once `patience` evaluated epochs in a row bring no new best
+/// model; the steps before are those of the full run, and resuming the final checkpoint
+/// does not train further.
+#[test]
+fn early_stopping_ends_the_run_after_patience_epochs_without_a_new_best() {
+    let obj = noisy();
+    let lens = [20, 13, 9];
+    let config = TrainConfig {
+        budget: Budget::Epochs(200),
+        patience: Some(4),
+        ..resume_config()
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let ck_path = dir.path().join("early.ckpt.json");
+    let run = |config: &TrainConfig, resume: Option<Checkpoint>| {
+        let mut ev = eval_fn;
+        train(
+            &obj,
+            &lens,
+            &[0.0; 4],
+            config,
+            TrainHooks {
+                evaluate: Some(&mut ev),
+                checkpoint: Some(ck_path.clone()),
+                ..TrainHooks::default()
+            },
+            resume,
+        )
+        .unwrap()
+    };
+    let early = run(&config, None);
+    let h = &early.state.history;
+    assert!(early.early_stopped && early.state.step < early.total_steps);
+    // The validation distance falls, then rises as θ moves past the validation point
+    // towards the optimum: the best epoch is followed by exactly 4 epochs without a new best.
+    let best = early.state.best.as_ref().unwrap().epoch as usize;
+    assert_eq!(h.len(), best + 1 + 4, "best epoch {best}");
+    assert!(h[best].is_best && h[best + 1..].iter().all(|r| !r.is_best));
+
+    let full = run(
+        &TrainConfig {
+            patience: None,
+            ..config.clone()
+        },
+        None,
+    );
+    assert!(!full.early_stopped && full.state.step == full.total_steps);
+    assert_eq!(&full.state.history[..h.len()], &h[..]);
+    assert_eq!(full.state.best, early.state.best);
+
+    // The final checkpoint (written by the full run) is replaced by the early run's.
+    let early = run(&config, None);
+    let again = run(&config, Some(Checkpoint::load(&ck_path).unwrap()));
+    assert!(again.early_stopped);
+    assert_eq!(again.state, early.state);
+
+    let zero = TrainConfig {
+        patience: Some(0),
+        ..config
+    };
+    let err = train(&obj, &lens, &[0.0; 4], &zero, TrainHooks::default(), None).unwrap_err();
+    assert!(err.to_string().contains("patience"), "{err}");
+}

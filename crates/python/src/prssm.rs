@@ -210,14 +210,15 @@ impl Stream {
 }
 
 /// Trains a PR-SSM on the training trajectories of `dataset` (`flapssm train`), writing the
-/// best model to `out`, the last to `<out>.last.json` and checkpoints to `<out>.ckpt.json`.
+/// best model to `out`, the last to `<out>.last.json`, checkpoints to `<out>.ckpt.json` and
+/// the learning curve (one row per evaluated epoch, with wall time) to `<out>.curve.csv`.
 /// Returns the best model. Ctrl-C (or an exception of `progress`) stops at the next step
 /// with a checkpoint; `resume=True` continues from it.
 #[pyfunction]
 #[pyo3(signature = (dataset, out, preset="paper", dx=None, inducing=None, particles=None,
     epochs=None, iterations=None, batch=None, lr=None, seed=0, val_fraction=0.1,
     checkpoint_every=10, resume=false, progress=None, best_by="rmse",
-    objective="standard"))]
+    objective="standard", inducing_init=None, patience=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn train(
     py: Python<'_>,
@@ -238,6 +239,8 @@ pub fn train(
     progress: Option<Py<PyAny>>,
     best_by: &str,
     objective: &str,
+    inducing_init: Option<&str>,
+    patience: Option<u64>,
 ) -> PyResult<Prssm> {
     let best_by: flapssm_prssm::train::BestBy = best_by
         .parse()
@@ -245,6 +248,10 @@ pub fn train(
     let objective: flapssm_prssm::train::fit::ObjectiveForm = objective
         .parse()
         .map_err(|e: String| PyValueError::new_err(format!("objective: {e}")))?;
+    let inducing_init: Option<flapssm_prssm::train::InducingInit> = inducing_init
+        .map(str::parse)
+        .transpose()
+        .map_err(|e: String| PyValueError::new_err(format!("inducing_init: {e}")))?;
     let plan = TrainingOptions {
         preset: preset
             .parse()
@@ -262,13 +269,18 @@ pub fn train(
         val_fraction,
         best_by,
         objective,
+        inducing_init,
+        patience,
         checkpoint_every,
     }
     .check()
     .map_err(|e| job_error(e, None))?;
     let files = TrainFiles::beside(&out, None);
-    flapssm_jobs::files::check_outputs(&[&files.model, &files.last, &files.checkpoint], &[])
-        .map_err(|e| job_error(e, None))?;
+    flapssm_jobs::files::check_outputs(
+        &[&files.model, &files.last, &files.checkpoint, &files.curve],
+        &[],
+    )
+    .map_err(|e| job_error(e, None))?;
     let bar = PyProgress::new(progress);
     let result =
         py.detach(|| train_dataset(&dataset.inner, &plan, &files, resume, &bar, Some(&bar.stop)));

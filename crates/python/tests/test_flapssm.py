@@ -98,6 +98,8 @@ def test_bad_input_raises_the_right_exception(small, tmp_path):
         flapssm.train(small, tmp_path / "m.json", best_by="lowest")
     with pytest.raises(ValueError, match="objective"):
         flapssm.train(small, tmp_path / "m.json", objective="tf1")
+    with pytest.raises(ValueError, match="inducing_init"):
+        flapssm.train(small, tmp_path / "m.json", inducing_init="grid")
     with pytest.raises(OSError, match="is a directory"):
         small.save(tmp_path)
 
@@ -124,6 +126,15 @@ def test_keyboard_interrupt_leaves_a_resumable_checkpoint(small, tmp_path):
     resumed = _tiny(small, out, resume=True)
     assert resumed.to_json() == whole.to_json()
     assert len(calls) > 3
+    # The learning curve: one row per evaluated epoch, continued across the interruption.
+    rows = (tmp_path / "m.curve.csv").read_text().splitlines()
+    assert rows[1] == "epoch,step,wall_s,mean_loss,train_rmse,val_rmse"
+    assert [int(r.split(",")[0]) for r in rows[2:]] == list(range(6))
+
+
+def test_kmeans_start_is_recorded(small, tmp_path):
+    model = _tiny(small, tmp_path / "k.json", inducing_init="kmeans")
+    assert json.loads(model.to_json())["training"]["spec"]["inducing_init"] == "kmeans"
 
 
 def test_ctrl_c_from_outside_stops_training_with_a_checkpoint(small, tmp_path):

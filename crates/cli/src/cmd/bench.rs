@@ -1,11 +1,14 @@
 //! `flapssm bench`: speed of the PR-SSM engine in the paper's configuration, compared with
 //! the authors' code (81.8 s per epoch, 0.152 s per 470-step prediction; prssm-notes §3).
 
+use std::path::{Path, PathBuf};
+
 use anyhow::Context;
 use clap::Args;
 use flapssm_jobs::bench::{
     AUTHORS_EPOCH_S, AUTHORS_PREDICT_S, BenchSettings, bench, speed_against_reference_machine,
 };
+use flapssm_jobs::curve::{CONVERGED_TAIL, QUALITY_TOLERANCE, read_curve, time_to_quality};
 use flapssm_prssm::train::bench::REFERENCE_SOLVE_S;
 
 /// Measure training, prediction and streaming speed (release build, this machine).
@@ -20,10 +23,64 @@ pub struct BenchArgs {
     /// Seed of the synthetic data and parameters.
     #[arg(long, default_value_t = 0)]
     seed: u64,
+    /// Also report time-to-quality: the wall time at which this learning curve (a training
+    /// run's `<model stem>.curve.csv`) first came within 2 % of the converged validation RMSE.
+    #[arg(long, value_name = "CURVE")]
+    train: Option<PathBuf>,
+    /// Learning curve of the published schedule (Adam 0.03, 1000 epochs) on the same data:
+    /// its converged value is the median of its last 10 % of evaluated epochs (default: the
+    /// --train curve itself).
+    #[arg(long, value_name = "CURVE", requires = "train")]
+    reference: Option<PathBuf>,
+}
+
+/// Prints the time-to-quality of `run` against `reference`.
+fn print_time_to_quality(run: &Path, reference: &Path) -> anyhow::Result<()> {
+    let points = read_curve(run)?;
+    let reference_points = if reference == run {
+        points.clone()
+    } else {
+        read_curve(reference)?
+    };
+    let q = time_to_quality(&points, &reference_points, reference, QUALITY_TOLERANCE)?;
+    let ref_last = reference_points.last().map_or(0, |p| p.epoch + 1);
+    println!(
+        "time to quality of {}: converged validation RMSE {:.4} (median of the last {:.0} % of \
+         {}, {} epochs), threshold {:.4} (+{:.0} %)",
+        run.display(),
+        q.converged_rmse,
+        100.0 * CONVERGED_TAIL,
+        reference.display(),
+        ref_last,
+        q.threshold,
+        100.0 * QUALITY_TOLERANCE
+    );
+    match q.reached {
+        Some(p) => println!(
+            "  reached at epoch {} (step {}) after {:.1} s = {:.1} min of training",
+            p.epoch,
+            p.step,
+            p.wall_s,
+            p.wall_s / 60.0
+        ),
+        None => println!(
+            "  not reached: last epoch {} (step {}, {:.1} min) at {:.4}, best {:.4}",
+            q.last.epoch,
+            q.last.step,
+            q.last.wall_s / 60.0,
+            q.last.val_rmse,
+            q.best_rmse
+        ),
+    }
+    Ok(())
 }
 
 /// Runs `flapssm bench`.
 pub fn run(args: BenchArgs) -> anyhow::Result<()> {
+    if let Some(curve) = &args.train {
+        print_time_to_quality(curve, args.reference.as_deref().unwrap_or(curve))
+            .context("flapssm bench --train")?;
+    }
     let r = bench(&BenchSettings {
         batches: usize::from(args.batches),
         reps: args.reps,

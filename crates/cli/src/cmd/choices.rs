@@ -2,8 +2,8 @@
 
 use clap::ValueEnum;
 use flapssm_jobs::simulate::TrajectorySource;
-use flapssm_prssm::train::BestBy;
 use flapssm_prssm::train::fit::ObjectiveForm;
+use flapssm_prssm::train::{BestBy, InducingInit};
 
 /// `--source`: where the wing's trajectories come from.
 #[derive(Clone, Copy, ValueEnum)]
@@ -56,6 +56,24 @@ impl From<ObjectiveArg> for ObjectiveForm {
         match o {
             ObjectiveArg::Standard => ObjectiveForm::Standard,
             ObjectiveArg::PublishedCode => ObjectiveForm::PublishedCode,
+        }
+    }
+}
+
+/// `--inducing-init`: how the inducing inputs and `q(u)` means start.
+#[derive(Clone, Copy, ValueEnum)]
+pub enum InducingInitArg {
+    /// Uniform in [−2, 2] (standardized units), as the published code.
+    Uniform,
+    /// k-means of the training inputs visited; `q(u)` means from the output increments.
+    Kmeans,
+}
+
+impl From<InducingInitArg> for InducingInit {
+    fn from(i: InducingInitArg) -> Self {
+        match i {
+            InducingInitArg::Uniform => InducingInit::Uniform,
+            InducingInitArg::Kmeans => InducingInit::Kmeans,
         }
     }
 }

@@ -9,7 +9,7 @@ use flapssm_jobs::demo::{DEMO_FILES, DemoConfig, run_demo};
 use flapssm_jobs::evaluate::EVALUATION_FILES;
 use flapssm_jobs::files::check_output_dir;
 
-use crate::cmd::choices::{BestByArg, ObjectiveArg, SourceArg};
+use crate::cmd::choices::{BestByArg, InducingInitArg, ObjectiveArg, SourceArg};
 use crate::progress::{Bars, stop_flag};
 
 /// Run the whole pipeline on a simulated wing.
@@ -56,6 +56,13 @@ pub struct DemoArgs {
     /// authors' objective and shared noise draws).
     #[arg(long, value_enum, value_name = "FORM")]
     objective: Option<ObjectiveArg>,
+    /// Override how the inducing inputs and q(u) means start: uniform (the published code)
+    /// or kmeans of the training inputs.
+    #[arg(long, value_enum, value_name = "RULE")]
+    inducing_init: Option<InducingInitArg>,
+    /// Early stopping: end training when N evaluated epochs in a row bring no new best model.
+    #[arg(long, value_name = "N", value_parser = super::positive::<u64>)]
+    patience: Option<u64>,
     /// Override where the trajectories come from: generator (the default) or paper (the
     /// paper's measured trajectories, the default with --full; the first --trajectories).
     #[arg(long, value_enum, value_name = "SOURCE")]
@@ -104,6 +111,12 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
     }
     if let Some(o) = args.objective {
         cfg.training.objective = o.into();
+    }
+    if let Some(i) = args.inducing_init {
+        cfg.training.inducing_init = Some(i.into());
+    }
+    if args.patience.is_some() {
+        cfg.training.patience = args.patience;
     }
     let stop = stop_flag()?;
     let bars = Bars::new();

@@ -114,6 +114,8 @@ fn run_one(a: RunArgs) -> anyhow::Result<()> {
         val_fraction: a.val_fraction,
         best_by: Default::default(),
         objective: Default::default(),
+        inducing_init: None,
+        patience: None,
         checkpoint_every: 0,
     };
     let plan = SweepSettings {

@@ -11,6 +11,8 @@ use flapssm_jobs::sysid::{
 };
 use flapssm_prssm::train::LrSchedule;
 
+use crate::cmd::choices::InducingInitArg;
+
 /// Fit a PR-SSM on the first part of a record, simulate the rest open loop, report test
 /// RMSE (raw units) and NLL per seed and mean ± std.
 #[derive(Args)]
@@ -46,6 +48,10 @@ pub struct SysidArgs {
     /// Cosine-anneal the learning rate to `lr · F` at the last step (default: constant).
     #[arg(long, value_name = "F")]
     cosine: Option<f64>,
+    /// How the inducing inputs and q(u) means start: uniform (the protocol's) or kmeans of
+    /// the training inputs.
+    #[arg(long, value_enum, default_value = "uniform")]
+    inducing_init: InducingInitArg,
     /// Also score the last parameters of each fit (not only the selected best), for diagnosis.
     #[arg(long)]
     diagnose_last: bool,
@@ -118,6 +124,7 @@ pub fn run(args: SysidArgs) -> anyhow::Result<()> {
     }
     .with_iterations(args.iterations);
     spec.fit.train.lr = args.lr;
+    spec.fit.inducing_init = args.inducing_init.into();
     if let Some(f) = args.cosine {
         spec.fit.train.schedule = LrSchedule::Cosine { final_factor: f };
     }

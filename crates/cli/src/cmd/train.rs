@@ -10,7 +10,7 @@ use flapssm_prssm::train::LrSchedule;
 use flapssm_prssm::train::fit::Preset;
 use flapssm_wing::dataset::Dataset;
 
-use crate::cmd::choices::{BestByArg, ObjectiveArg};
+use crate::cmd::choices::{BestByArg, InducingInitArg, ObjectiveArg};
 use crate::progress::{Bars, stop_flag};
 
 /// Train a PR-SSM (negative-ELBO minimization with Adam).
@@ -64,6 +64,13 @@ pub struct TrainArgs {
     /// objective and shared noise draws, to re-run their exact training).
     #[arg(long, value_enum, default_value = "standard")]
     objective: ObjectiveArg,
+    /// How the inducing inputs and q(u) means start: uniform (the published code) or kmeans
+    /// of the training inputs (default: the preset's).
+    #[arg(long, value_enum)]
+    inducing_init: Option<InducingInitArg>,
+    /// Early stopping: end the run when N evaluated epochs in a row bring no new best model.
+    #[arg(long, value_name = "N", value_parser = super::positive::<u64>)]
+    patience: Option<u64>,
     /// Write a checkpoint every N epochs (0: only on Ctrl-C).
     #[arg(long, default_value_t = 10)]
     checkpoint_every: u64,
@@ -118,12 +125,14 @@ pub fn run(args: TrainArgs) -> anyhow::Result<()> {
         val_fraction: args.val_fraction,
         best_by: args.best_by.into(),
         objective: args.objective.into(),
+        inducing_init: args.inducing_init.map(Into::into),
+        patience: args.patience,
         checkpoint_every: args.checkpoint_every,
     }
     .check()?;
     let files = TrainFiles::beside(&args.out, args.checkpoint.clone());
     flapssm_jobs::files::check_outputs(
-        &[&files.model, &files.last, &files.checkpoint],
+        &[&files.model, &files.last, &files.checkpoint, &files.curve],
         &[&args.dataset],
     )?;
     let ds = Dataset::load(&args.dataset)

@@ -861,7 +861,7 @@ mod tests {
             ..TrainingOptions::default()
         };
         let plan = opts.check().unwrap();
-        let fit = train_prssm(ds.train(), &plan, None, None, &NoProgress, None).unwrap();
+        let fit = train_prssm(ds.train(), &plan, None, None, None, &NoProgress, None).unwrap();
         let dir = std::env::temp_dir().join(format!("flapssm-pipeline-{}", std::process::id()));
         let eo = EvalOptions {
             start_sample: 0,

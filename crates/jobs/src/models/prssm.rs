@@ -172,7 +172,7 @@ impl Fit for PrssmFit {
     type Model = PrssmLoadModel<'static>;
 
     fn fit(&self, ds: &ValidDataset, progress: &dyn Progress) -> Result<Self::Model> {
-        let out = train_prssm(ds.train(), &self.plan, None, None, progress, None)?;
+        let out = train_prssm(ds.train(), &self.plan, None, None, None, progress, None)?;
         Ok(PrssmLoadModel::new(&out.best, ds, self.particles, self.seed)?.into_owned())
     }
 }
@@ -206,7 +206,7 @@ mod tests {
         }
         .fit(&ds, &NoProgress)
         .unwrap();
-        let out = train_prssm(ds.train(), &plan, None, None, &NoProgress, None).unwrap();
+        let out = train_prssm(ds.train(), &plan, None, None, None, &NoProgress, None).unwrap();
         assert_eq!(fitted.model().params, out.best.params);
         assert_eq!(fitted.training_history().map(<[_]>::len), Some(2));
         let direct = PrssmLoadModel::new(&out.best, &ds, 4, 2).unwrap();

@@ -24,6 +24,7 @@ use serde::{Deserialize, Serialize};
 
 use super::batches::{BatchPlan, WindowSpec, derive_seed};
 use super::checkpoint::Checkpoint;
+use super::inducing::{InducingInit, kmeans_start};
 use super::initial::{InitialStateModel, InitialStateSpec, RecognizedElbo};
 use super::recognition::{Recognition, RecognitionConfig};
 use super::schedule::LrSchedule;
@@ -117,6 +118,9 @@ pub struct FitSpec {
     /// The objective's form (older specs: standard).
     #[serde(default)]
     pub objective: ObjectiveForm,
+    /// How `Z` and the `q(u)` means start (older specs: uniform).
+    #[serde(default)]
+    pub inducing_init: InducingInit,
 }
 
 impl FitSpec {
@@ -140,6 +144,7 @@ impl FitSpec {
                 eval_particles: 30,
                 eval_max_sequences: 16,
                 objective: ObjectiveForm::Standard,
+                inducing_init: InducingInit::Uniform,
             },
             Preset::Sysid => {
                 let mut model = ModelConfig::new(4.max(n_output), n_output, n_input, 20);
@@ -165,6 +170,7 @@ impl FitSpec {
                     eval_particles: 50,
                     eval_max_sequences: 16,
                     objective: ObjectiveForm::Standard,
+                    inducing_init: InducingInit::Uniform,
                 }
             }
         }
@@ -402,7 +408,15 @@ pub fn fit(
     let elbo = Elbo::new(cfg.clone(), data, options)?;
     let train_z = elbo.data().sequences();
     let seed = spec.train.seed;
-    let mut init = Params::init(cfg, &spec.init, derive_seed(seed, 3, 0)).unconstrained(cfg);
+    let mut start = Params::init(cfg, &spec.init, derive_seed(seed, 3, 0));
+    if spec.inducing_init == InducingInit::Kmeans {
+        let burn_in = match spec.initial_state {
+            InitialStateSpec::Zeros => spec.burn_in_fraction,
+            _ => 0.0,
+        };
+        kmeans_start(cfg, train_z, burn_in, derive_seed(seed, 8, 0), &mut start)?;
+    }
+    let mut init = start.unconstrained(cfg);
     let recognized = match spec.initial_state {
         InitialStateSpec::Recognition(rc) => Some(RecognizedElbo::new(&elbo, rc)),
         _ => None,

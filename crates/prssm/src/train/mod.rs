@@ -7,6 +7,7 @@
 //! - [`batches`]: windows, shuffled minibatches and seed derivation.
 //! - [`bench`](mod@bench): speed measurements of the paper's configuration.
 //! - [`checkpoint`]: the complete run state, saved atomically.
+//! - [`inducing`]: uniform or k-means starting values of the inducing inputs and `q(u)` means.
 //! - [`initial`]: initial-state rules and the ELBO with a recognition model.
 //! - [`fit`](mod@fit): presets and fitting a PR-SSM to raw sequences; prediction with its rule.
 //! - [`recognition`]: the recognition model `(u, y)_{0..k} ↦ N(m₀, diag(s₀²))`.
@@ -17,6 +18,7 @@ pub mod batches;
 pub mod bench;
 pub mod checkpoint;
 pub mod fit;
+pub mod inducing;
 pub mod initial;
 pub mod recognition;
 pub mod schedule;
@@ -26,6 +28,7 @@ pub use adam::{Adam, AdamParams};
 pub use batches::{BatchError, BatchPlan, WindowSpec, derive_seed};
 pub use checkpoint::{BestModel, Checkpoint, CheckpointError, EpochRecord, TrainState};
 pub use fit::{FitError, FitOutcome, FitSpec, Preset, TrainingRecord, fit, predict_raw};
+pub use inducing::InducingInit;
 pub use initial::{InitialStateModel, InitialStateSpec, RecognizedElbo};
 pub use recognition::{Recognition, RecognitionConfig};
 pub use schedule::LrSchedule;

@@ -119,6 +119,10 @@ pub struct TrainConfig {
     /// How the best model is chosen among the evaluated epochs.
     #[serde(default)]
     pub best_by: BestBy,
+    /// Early stopping: end the run when this many evaluated epochs in a row brought no new
+    /// best model (`None`: run the whole budget).
+    #[serde(default)]
+    pub patience: Option<u64>,
     /// What else defines the run (e.g. the model specification and a fingerprint of the
     /// training data); compared like every other field when resuming. `null` if unused.
     #[serde(default)]
@@ -140,6 +144,7 @@ impl Default for TrainConfig {
             checkpoint_every: 0,
             divergence: DivergenceGuard::default(),
             best_by: BestBy::default(),
+            patience: None,
             run_context: serde_json::Value::Null,
         }
     }
@@ -294,6 +299,9 @@ pub struct TrainOutcome {
     pub total_steps: u64,
     /// Whether the run stopped early on request.
     pub interrupted: bool,
+    /// Whether the run ended before its budget because the best model had not improved for
+    /// [`TrainConfig::patience`] evaluated epochs.
+    pub early_stopped: bool,
 }
 
 impl TrainOutcome {
@@ -343,6 +351,9 @@ impl TrainConfig {
         }
         if self.eval_every == 0 {
             return bad("eval_every", "0".into(), "must be at least 1");
+        }
+        if self.patience == Some(0) {
+            return bad("patience", "0".into(), "must be at least 1 evaluated epoch");
         }
         match self.budget {
             Budget::Epochs(0) | Budget::Iterations(0) => {
@@ -539,7 +550,15 @@ pub fn train<O: Objective + ?Sized>(
     let mut order = Vec::new();
     let mut order_epoch = u64::MAX;
     let mut batch: Vec<Window> = Vec::with_capacity(config.batch_size);
+    let mut early_stopped = false;
     while state.step < total_steps {
+        if config
+            .patience
+            .is_some_and(|p| patience_exhausted(&state.history, p))
+        {
+            early_stopped = true;
+            break;
+        }
         if stop.is_some_and(|s| s.load(Ordering::SeqCst)) {
             save(&state)?;
             if let Some(path) = &checkpoint {
@@ -553,6 +572,7 @@ pub fn train<O: Objective + ?Sized>(
                 state,
                 total_steps,
                 interrupted: true,
+                early_stopped: false,
             });
         }
         let t = state.step;
@@ -701,5 +721,13 @@ pub fn train<O: Objective + ?Sized>(
         state,
         total_steps,
         interrupted: false,
+        early_stopped,
     })
+}
+
+/// Whether the last `patience` evaluated epochs all failed to improve the best model (and
+/// at least one epoch did before them).
+fn patience_exhausted(history: &[EpochRecord], patience: u64) -> bool {
+    let p = patience as usize;
+    history.len() > p && history[history.len() - p..].iter().all(|r| !r.is_best)
 }
