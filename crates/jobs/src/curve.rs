@@ -287,6 +287,26 @@ pub fn time_to_quality(
     })
 }
 
+/// Where early stopping with `patience` would have ended a run recorded without it: the
+/// evaluated epoch at which the last `patience` epochs brought no new lowest validation RMSE,
+/// and the best epoch kept then. `None` when the run never stalled that long.
+pub fn early_stop_point(run: &[CurvePoint], patience: usize) -> Option<(CurvePoint, CurvePoint)> {
+    let mut best: Option<CurvePoint> = None;
+    let mut since = 0;
+    for p in run {
+        if best.is_none_or(|b| p.val_rmse < b.val_rmse) {
+            best = Some(*p);
+            since = 0;
+        } else {
+            since += 1;
+            if since == patience {
+                return best.map(|b| (*p, b));
+            }
+        }
+    }
+    None
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -327,6 +347,17 @@ mod tests {
                 .reached
                 .is_none()
         );
+        // Patience 2 on 0.5, 0.3265, 0.326: never stalls; on a rise it stops two epochs later.
+        assert!(early_stop_point(&run, 2).is_none());
+        let rise = [
+            point(0, 1.0, 0.5),
+            point(1, 2.0, 0.4),
+            point(2, 3.0, 0.45),
+            point(3, 4.0, 0.41),
+            point(4, 5.0, 0.3),
+        ];
+        let (stop, kept) = early_stop_point(&rise, 2).unwrap();
+        assert_eq!((stop.epoch, kept.epoch), (3, 1));
         let none = [point(0, 1.0, f64::NAN)];
         let e = converged_rmse(&none, p).unwrap_err().to_string();
         assert!(e.contains("ref.csv") && e.contains("validation"), "{e}");

@@ -8,7 +8,9 @@ use clap::Args;
 use flapssm_jobs::bench::{
     AUTHORS_EPOCH_S, AUTHORS_PREDICT_S, BenchSettings, bench, speed_against_reference_machine,
 };
-use flapssm_jobs::curve::{CONVERGED_TAIL, QUALITY_TOLERANCE, read_curve, time_to_quality};
+use flapssm_jobs::curve::{
+    CONVERGED_TAIL, QUALITY_TOLERANCE, early_stop_point, read_curve, time_to_quality,
+};
 use flapssm_prssm::train::bench::REFERENCE_SOLVE_S;
 
 /// Measure training, prediction and streaming speed (release build, this machine).
@@ -32,10 +34,18 @@ pub struct BenchArgs {
     /// --train curve itself).
     #[arg(long, value_name = "CURVE", requires = "train")]
     reference: Option<PathBuf>,
+    /// Also say where early stopping with this patience (evaluated epochs without a new best
+    /// validation RMSE) would have ended the --train run, and what it would have kept.
+    #[arg(long, value_name = "N", requires = "train", value_parser = super::positive::<usize>)]
+    patience: Option<usize>,
 }
 
 /// Prints the time-to-quality of `run` against `reference`.
-fn print_time_to_quality(run: &Path, reference: &Path) -> anyhow::Result<()> {
+fn print_time_to_quality(
+    run: &Path,
+    reference: &Path,
+    patience: Option<usize>,
+) -> anyhow::Result<()> {
     let points = read_curve(run)?;
     let reference_points = if reference == run {
         points.clone()
@@ -72,14 +82,32 @@ fn print_time_to_quality(run: &Path, reference: &Path) -> anyhow::Result<()> {
             q.best_rmse
         ),
     }
+    if let Some(n) = patience {
+        match early_stop_point(&points, n) {
+            Some((stop, kept)) => println!(
+                "  with --patience {n}: stops at epoch {} after {:.1} min, keeps epoch {} at \
+                 {:.4} ({:+.1} % of converged)",
+                stop.epoch,
+                stop.wall_s / 60.0,
+                kept.epoch,
+                kept.val_rmse,
+                100.0 * (kept.val_rmse / q.converged_rmse - 1.0)
+            ),
+            None => println!("  with --patience {n}: would not have stopped early"),
+        }
+    }
     Ok(())
 }
 
 /// Runs `flapssm bench`.
 pub fn run(args: BenchArgs) -> anyhow::Result<()> {
     if let Some(curve) = &args.train {
-        print_time_to_quality(curve, args.reference.as_deref().unwrap_or(curve))
-            .context("flapssm bench --train")?;
+        print_time_to_quality(
+            curve,
+            args.reference.as_deref().unwrap_or(curve),
+            args.patience,
+        )
+        .context("flapssm bench --train")?;
     }
     let r = bench(&BenchSettings {
         batches: usize::from(args.batches),

@@ -11,6 +11,7 @@ use flapssm_jobs::train::TrainingOptions;
 use flapssm_prssm::train::fit::Preset;
 use flapssm_wing::dataset::Dataset;
 
+use crate::cmd::choices::InducingInitArg;
 use crate::progress::{Bars, stop_flag};
 
 /// Sweep subcommands.
@@ -68,6 +69,12 @@ pub struct RunArgs {
     /// Fraction of the training trajectories held out for best-model selection.
     #[arg(long, default_value_t = 0.1)]
     val_fraction: f64,
+    /// How the inducing inputs and q(u) means start: uniform (the published code) or kmeans.
+    #[arg(long, value_enum)]
+    inducing_init: Option<InducingInitArg>,
+    /// Early stopping: end training when N evaluated epochs in a row bring no new best model.
+    #[arg(long, value_name = "N", value_parser = super::positive::<u64>)]
+    patience: Option<u64>,
     /// Particles of the evaluation predictions.
     #[arg(long, default_value_t = 30)]
     eval_particles: usize,
@@ -114,8 +121,8 @@ fn run_one(a: RunArgs) -> anyhow::Result<()> {
         val_fraction: a.val_fraction,
         best_by: Default::default(),
         objective: Default::default(),
-        inducing_init: None,
-        patience: None,
+        inducing_init: a.inducing_init.map(Into::into),
+        patience: a.patience,
         checkpoint_every: 0,
     };
     let plan = SweepSettings {
