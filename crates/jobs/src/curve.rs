@@ -68,15 +68,22 @@ pub struct CurveRecorder {
 
 impl CurveRecorder {
     /// A new curve written to `path`. When `resume_step` is given, the rows of an existing
-    /// file at `path` up to that step are kept and this run's wall time is added to theirs.
+    /// file at `path` up to that step are kept and this run's wall time is added to theirs;
+    /// otherwise the file is started afresh at once (header only), so that no earlier run's
+    /// rows outlive this run's start.
     ///
     /// # Errors
-    /// The file's read errors, naming it, when resuming from an unreadable curve.
+    /// The file's read errors, naming it, when resuming from an unreadable curve;
+    /// [`JobError::Io`] when it cannot be written.
     pub fn new(path: &Path, resume_step: Option<u64>) -> Result<Self> {
         let mut points = Vec::new();
-        if let Some(step) = resume_step.filter(|_| path.exists()) {
-            points = read_curve(path)?;
-            points.retain(|p| p.step <= step);
+        match resume_step {
+            Some(step) if path.exists() => {
+                points = read_curve(path)?;
+                points.retain(|p| p.step <= step);
+            }
+            Some(_) => {}
+            None => crate::files::write_text(path, &curve_text(&[]))?,
         }
         let offset_s = points.last().map_or(0.0, |p| p.wall_s);
         Ok(Self {
@@ -394,8 +401,9 @@ mod tests {
         let back = read_curve(&path).unwrap();
         assert_eq!(back.len(), 3);
         assert!(back[2].wall_s >= 3.25 && back[2].val_rmse == 0.6);
-        // A fresh run starts a new file.
+        // A fresh run starts a new file at once.
         assert!(CurveRecorder::new(&path, None).unwrap().points().is_empty());
+        assert!(read_curve(&path).unwrap().is_empty());
         std::fs::write(&path, "epoch,step\n1,2\n").unwrap();
         let e = read_curve(&path).unwrap_err().to_string();
         assert!(e.contains("m.curve.csv") && e.contains("wall_s"), "{e}");
