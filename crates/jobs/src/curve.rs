@@ -64,26 +64,22 @@ pub struct CurveRecorder {
     /// Wall seconds before this invocation (from the resumed curve).
     offset_s: f64,
     started: Instant,
+    /// Whether the file belongs to this run (resumed, or started by [`Self::begin`]).
+    begun: bool,
 }
 
 impl CurveRecorder {
     /// A new curve written to `path`. When `resume_step` is given, the rows of an existing
     /// file at `path` up to that step are kept and this run's wall time is added to theirs;
-    /// otherwise the file is started afresh at once (header only), so that no earlier run's
-    /// rows outlive this run's start.
+    /// otherwise [`CurveRecorder::begin`] starts the file afresh once training is under way.
     ///
     /// # Errors
-    /// The file's read errors, naming it, when resuming from an unreadable curve;
-    /// [`JobError::Io`] when it cannot be written.
+    /// The file's read errors, naming it, when resuming from an unreadable curve.
     pub fn new(path: &Path, resume_step: Option<u64>) -> Result<Self> {
         let mut points = Vec::new();
-        match resume_step {
-            Some(step) if path.exists() => {
-                points = read_curve(path)?;
-                points.retain(|p| p.step <= step);
-            }
-            Some(_) => {}
-            None => crate::files::write_text(path, &curve_text(&[]))?,
+        if let Some(step) = resume_step.filter(|_| path.exists()) {
+            points = read_curve(path)?;
+            points.retain(|p| p.step <= step);
         }
         let offset_s = points.last().map_or(0.0, |p| p.wall_s);
         Ok(Self {
@@ -91,7 +87,22 @@ impl CurveRecorder {
             points,
             offset_s,
             started: Instant::now(),
+            begun: resume_step.is_some(),
         })
+    }
+
+    /// Called at every optimizer step: the first call of a fresh run writes the file with
+    /// no rows, so that no earlier run's rows outlive this run's first step (a refused run
+    /// changes nothing on disk).
+    ///
+    /// # Errors
+    /// [`JobError::Io`] naming the file.
+    pub fn begin(&mut self) -> Result<()> {
+        if !self.begun {
+            self.begun = true;
+            crate::files::write_text(&self.path, &curve_text(&self.points))?;
+        }
+        Ok(())
     }
 
     /// Records an evaluated epoch and rewrites the file.
@@ -401,8 +412,11 @@ mod tests {
         let back = read_curve(&path).unwrap();
         assert_eq!(back.len(), 3);
         assert!(back[2].wall_s >= 3.25 && back[2].val_rmse == 0.6);
-        // A fresh run starts a new file at once.
-        assert!(CurveRecorder::new(&path, None).unwrap().points().is_empty());
+        // A fresh run leaves the file alone until its first step, then starts it afresh.
+        let mut fresh = CurveRecorder::new(&path, None).unwrap();
+        assert!(fresh.points().is_empty());
+        assert_eq!(read_curve(&path).unwrap().len(), 3);
+        fresh.begin().unwrap();
         assert!(read_curve(&path).unwrap().is_empty());
         std::fs::write(&path, "epoch,step\n1,2\n").unwrap();
         let e = read_curve(&path).unwrap_err().to_string();

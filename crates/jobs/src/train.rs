@@ -289,8 +289,14 @@ pub fn train_prssm(
     )?;
     let fit_seqs: Vec<SequenceView<'_>> = fit_set.iter().map(trajectory_sequence).collect();
     let val_seqs: Vec<SequenceView<'_>> = val_set.iter().map(trajectory_sequence).collect();
+    // A learning curve that cannot be written is reported once and dropped; training goes on.
     let mut curve = curve;
-    let mut curve_error = None;
+    let curve_failed = |curve: &mut Option<&mut CurveRecorder>, e: JobError| {
+        progress.println(&format!(
+            "warning: learning curve not written ({e}); training continues"
+        ));
+        *curve = None;
+    };
     let mut on_event = |e: &TrainEvent<'_>| match e {
         TrainEvent::Step {
             step,
@@ -299,14 +305,15 @@ pub fn train_prssm(
             loss,
             lr,
         } => {
+            if let Some(Err(e)) = curve.as_mut().map(|c| c.begin()) {
+                curve_failed(&mut curve, e);
+            }
             progress.set(step + 1, *total_steps);
             progress.message(&format!("epoch {epoch} loss {loss:.4e} lr {lr:.2e}"));
         }
         TrainEvent::Epoch(r) => {
-            if let Some(c) = curve.as_mut()
-                && let Err(e) = c.record(r)
-            {
-                curve_error.get_or_insert(e);
+            if let Some(Err(e)) = curve.as_mut().map(|c| c.record(r)) {
+                curve_failed(&mut curve, e);
             }
             let f = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.4}"));
             progress.println(&format!(
@@ -354,9 +361,6 @@ pub fn train_prssm(
         what: "training".into(),
         source,
     })?;
-    if let Some(e) = curve_error {
-        return Err(e);
-    }
     if out.outcome.early_stopped {
         progress.println(&format!(
             "stopped early at step {} of {}: no new best model for {} evaluated epochs",
