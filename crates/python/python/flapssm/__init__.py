@@ -170,19 +170,23 @@ def train(
     progress: Optional[Progress] = None,
     best_by: str = "rmse",
     objective: str = "standard",
+    inducing_init: Optional[str] = None,
+    patience: Optional[int] = None,
 ) -> "_native.Prssm":
     """Trains a PR-SSM (``flapssm train``) on the dataset's training trajectories; writes
-    the best model to ``out``, the last to ``<out>.last.json`` and checkpoints to
-    ``<out>.ckpt.json``. Ctrl-C raises ``KeyboardInterrupt`` after a checkpoint;
+    the best model to ``out``, the last to ``<out>.last.json``, checkpoints to
+    ``<out>.ckpt.json`` and the learning curve to ``<out>.curve.csv``. Ctrl-C raises ``KeyboardInterrupt`` after a checkpoint;
     ``resume=True`` continues from it (a larger budget extends a finished run). ``best_by``:
     ``"rmse"`` (validation, else training rollouts) or ``"training-loss"`` (the published
     code's ``best.ckpt``; with ``val_fraction=0``, the published protocol). ``objective``:
     ``"standard"`` (the unbiased ELBO) or ``"published-code"`` (the authors' objective and
-    shared noise draws, to re-run their exact training)."""
+    shared noise draws, to re-run their exact training). ``inducing_init``: ``"uniform"``
+    or ``"kmeans"`` (default: the preset's). ``patience``: end when that many evaluated
+    epochs in a row bring no new best model."""
     return _native.train(
         dataset, os.fspath(out), preset, dx, inducing, particles, epochs, iterations, batch,
         lr, int(seed), float(val_fraction), int(checkpoint_every), bool(resume), progress,
-        best_by, objective,
+        best_by, objective, inducing_init, None if patience is None else int(patience),
     )
 
 
