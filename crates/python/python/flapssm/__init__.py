@@ -175,10 +175,11 @@ def train(
 ) -> "_native.Prssm":
     """Trains a PR-SSM (``flapssm train``) on the dataset's training trajectories; writes
     the best model to ``out``, the last to ``<out>.last.json``, checkpoints to
-    ``<out>.ckpt.json`` and the learning curve to ``<out>.curve.csv``. Ctrl-C raises ``KeyboardInterrupt`` after a checkpoint;
-    ``resume=True`` continues from it (a larger budget extends a finished run). ``best_by``:
-    ``"rmse"`` (validation, else training rollouts) or ``"training-loss"`` (the published
-    code's ``best.ckpt``; with ``val_fraction=0``, the published protocol). ``objective``:
+    ``<out>.ckpt.json`` and the learning curve to ``<out>.curve.csv``. Ctrl-C raises
+    ``KeyboardInterrupt`` after a checkpoint; ``resume=True`` continues from it (a larger
+    budget extends a finished run). ``best_by``: ``"rmse"`` (validation, else training
+    rollouts) or ``"training-loss"`` (the published code's ``best.ckpt``; with
+    ``val_fraction=0``, the published protocol). ``objective``:
     ``"standard"`` (the unbiased ELBO) or ``"published-code"`` (the authors' objective and
     shared noise draws, to re-run their exact training). ``inducing_init``: ``"uniform"``
     or ``"kmeans"`` (default: the preset's). ``patience``: end when that many evaluated
