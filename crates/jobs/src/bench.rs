@@ -2,6 +2,7 @@
 //! D_x 12, M 100, 30 particles, batch 16) on synthetic data of its shapes, beside the authors'
 //! code (prssm-notes §3) and this machine's own f64 GEMM rate.
 
+use flapssm_prssm::Precision;
 use flapssm_prssm::train::bench::{
     REFERENCE_SOLVE_S, gemm_rate_gflops, initial_model, predict_step_flops,
     reference_solve_seconds, synthetic_objective, time_batches, time_prediction, time_stream_step,
@@ -31,6 +32,8 @@ pub struct BenchSettings {
     pub reps: usize,
     /// Seed of the synthetic data and parameters.
     pub seed: u64,
+    /// Arithmetic of the training products.
+    pub precision: Precision,
 }
 
 impl Default for BenchSettings {
@@ -39,6 +42,7 @@ impl Default for BenchSettings {
             batches: BATCHES_PER_EPOCH,
             reps: 9,
             seed: 0,
+            precision: Precision::F64,
         }
     }
 }
@@ -46,6 +50,8 @@ impl Default for BenchSettings {
 /// What [`bench()`] measured.
 #[derive(Debug, Clone, PartialEq)]
 pub struct BenchReport {
+    /// Arithmetic of the timed training products.
+    pub precision: Precision,
     /// Threads of the pool the training ran on.
     pub threads: usize,
     /// f64 GEMM rate (512³, faer, one thread), GFLOP/s.
@@ -71,7 +77,7 @@ pub struct BenchReport {
 }
 
 impl BenchReport {
-    /// Epoch time if every FLOP ran at `threads` × the GEMM rate (the f64 FLOP limit), s.
+    /// Epoch time if every FLOP ran at `threads` × the f64 GEMM rate (the f64 FLOP limit), s.
     pub fn flop_limit_epoch_s(&self) -> f64 {
         self.epoch_s * self.train_gflops / (self.threads as f64 * self.gemm_gflops)
     }
@@ -106,6 +112,7 @@ pub fn bench(settings: &BenchSettings) -> Result<BenchReport> {
     let reference_solve_s = reference_solve_seconds(0.2);
     let (elbo, params) = synthetic_objective(&spec, TRAIN_SEQUENCES, PREDICT_STEPS, settings.seed)
         .map_err(|e| engine("building the paper objective", e.into()))?;
+    let elbo = elbo.with_precision(settings.precision);
     let times = time_batches(&elbo, &params, settings.batches, settings.seed)
         .map_err(|e| engine("timing training batches", e.into()))?;
     let per_epoch = BATCHES_PER_EPOCH as f64 / settings.batches as f64;
@@ -116,6 +123,7 @@ pub fn bench(settings: &BenchSettings) -> Result<BenchReport> {
     let stream_step_s = time_stream_step(&model, spec.particles, 2000)
         .map_err(|e| engine("timing streaming", e.into()))?;
     Ok(BenchReport {
+        precision: settings.precision,
         threads: current_threads(),
         gemm_gflops,
         reference_solve_s,

@@ -4,11 +4,11 @@
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 
-use flapssm_prssm::SequenceView;
 use flapssm_prssm::train::fit::{FitError, FitOutcome, FitSpec, ObjectiveForm, Preset, fit};
 use flapssm_prssm::train::{
     BestBy, Budget, Checkpoint, InducingInit, LrSchedule, TrainEvent, TrainHooks,
 };
+use flapssm_prssm::{Precision, SequenceView};
 use flapssm_wing::dataset::{Trajectory, ValidDataset};
 use serde::{Deserialize, Serialize};
 
@@ -57,6 +57,9 @@ pub struct TrainingOptions {
     /// Early stopping: end when this many evaluated epochs in a row bring no new best model.
     #[serde(default)]
     pub patience: Option<u64>,
+    /// Arithmetic of the ELBO's large products (f64, the reference, or mixed).
+    #[serde(default)]
+    pub precision: Precision,
     /// Checkpoint every this many epochs (0: only when interrupted).
     pub checkpoint_every: u64,
 }
@@ -81,6 +84,7 @@ impl Default for TrainingOptions {
             objective: ObjectiveForm::Standard,
             inducing_init: None,
             patience: None,
+            precision: Precision::F64,
             checkpoint_every: 10,
         }
     }
@@ -124,6 +128,7 @@ impl TrainingOptions {
         if self.patience.is_some() {
             spec.train.patience = self.patience;
         }
+        spec.precision = self.precision;
         spec.train.seed = self.seed;
         spec.train.checkpoint_every = self.checkpoint_every;
         spec.train.best_by = self.best_by;

@@ -20,6 +20,8 @@
 //!   (initial state from [`InitialStateMode`]); [`Elbo::evaluate`] takes per-window initial
 //!   states `N(m₀, diag s₀²)` ([`InitialStates`], row-major `B × D_x`) and returns
 //!   `∂loss/∂m₀`, `∂loss/∂s₀` ([`InitialStateGrads`]) with the parameter gradient.
+//!   [`Elbo::with_precision`]`(`[`Precision::Mixed`]`)` forms the large products in `f32`
+//!   ([`precision`]).
 //! - [`predict::predict`] / [`predict::predict_with_draws`]: open-loop particle simulation
 //!   ([`predict::Prediction`]); [`predict::StepPredictor`]: one step at a time on caller
 //!   buffers, no allocation per step.
@@ -36,6 +38,7 @@ pub mod linalg;
 pub mod model;
 pub mod objective;
 pub mod params;
+pub mod precision;
 pub mod predict;
 pub mod published;
 pub mod stream;
@@ -56,3 +59,4 @@ pub use params::{
     ConfigError, CovarianceStructure, ModelConfig, ParamGrads, ParamInit, ParamLayout,
     Parametrization, Params,
 };
+pub use precision::Precision;

@@ -5,30 +5,50 @@ use faer::linalg::matmul::matmul;
 use faer::linalg::triangular_solve::{
     solve_lower_triangular_in_place, solve_upper_triangular_in_place,
 };
+use faer::traits::ComplexField;
 use faer::{Accum, MatMut, MatRef, Par};
 
 /// Column-major read-only view of `rows × cols` values.
 #[inline]
-pub(crate) fn view(data: &[f64], rows: usize, cols: usize) -> MatRef<'_, f64> {
+pub(crate) fn view<T>(data: &[T], rows: usize, cols: usize) -> MatRef<'_, T> {
     MatRef::from_column_major_slice(&data[..rows * cols], rows, cols)
 }
 
 /// Column-major mutable view of `rows × cols` values.
 #[inline]
-pub(crate) fn view_mut(data: &mut [f64], rows: usize, cols: usize) -> MatMut<'_, f64> {
+pub(crate) fn view_mut<T>(data: &mut [T], rows: usize, cols: usize) -> MatMut<'_, T> {
     MatMut::from_column_major_slice_mut(&mut data[..rows * cols], rows, cols)
 }
 
-/// `dst (+)= α · lhs · rhs` (sequential).
+/// `dst (+)= α · lhs · rhs` (sequential), in `f64` or `f32`.
 #[inline]
-pub(crate) fn gemm(
-    dst: MatMut<'_, f64>,
+pub(crate) fn gemm<T: ComplexField>(
+    dst: MatMut<'_, T>,
     accum: Accum,
-    lhs: MatRef<'_, f64>,
-    rhs: MatRef<'_, f64>,
-    alpha: f64,
+    lhs: MatRef<'_, T>,
+    rhs: MatRef<'_, T>,
+    alpha: T,
 ) {
     matmul(dst, accum, lhs, rhs, alpha, Par::Seq);
+}
+
+/// `dst[i] = src[i] as f32` over `src` (round to nearest).
+#[inline]
+pub(crate) fn round_into(src: &[f64], dst: &mut [f32]) {
+    dst[..src.len()]
+        .iter_mut()
+        .zip(src)
+        .for_each(|(d, &s)| *d = s as f32);
+}
+
+/// `dst[i] = src[i]` (`accum = Replace`) or `dst[i] += src[i]` (`Add`), widened to `f64`.
+#[inline]
+pub(crate) fn widen_into(src: &[f32], dst: &mut [f64], accum: Accum) {
+    let pairs = dst[..src.len()].iter_mut().zip(src);
+    match accum {
+        Accum::Replace => pairs.for_each(|(d, &s)| *d = f64::from(s)),
+        Accum::Add => pairs.for_each(|(d, &s)| *d += f64::from(s)),
+    }
 }
 
 /// `Σ aᵢbᵢ` in eight interleaved partial sums (vectorizes; fixed order, so deterministic).

@@ -218,7 +218,7 @@ impl Stream {
 #[pyo3(signature = (dataset, out, preset="paper", dx=None, inducing=None, particles=None,
     epochs=None, iterations=None, batch=None, lr=None, seed=0, val_fraction=0.1,
     checkpoint_every=10, resume=false, progress=None, best_by="rmse",
-    objective="standard", inducing_init=None, patience=None))]
+    objective="standard", inducing_init=None, patience=None, precision="f64"))]
 #[allow(clippy::too_many_arguments)]
 pub fn train(
     py: Python<'_>,
@@ -241,6 +241,7 @@ pub fn train(
     objective: &str,
     inducing_init: Option<&str>,
     patience: Option<u64>,
+    precision: &str,
 ) -> PyResult<Prssm> {
     let best_by: flapssm_prssm::train::BestBy = best_by
         .parse()
@@ -252,6 +253,9 @@ pub fn train(
         .map(str::parse)
         .transpose()
         .map_err(|e: String| PyValueError::new_err(format!("inducing_init: {e}")))?;
+    let precision: flapssm_prssm::Precision = precision
+        .parse()
+        .map_err(|e: String| PyValueError::new_err(format!("precision: {e}")))?;
     let plan = TrainingOptions {
         preset: preset
             .parse()
@@ -271,6 +275,7 @@ pub fn train(
         objective,
         inducing_init,
         patience,
+        precision,
         checkpoint_every,
     }
     .check()

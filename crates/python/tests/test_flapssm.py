@@ -100,6 +100,8 @@ def test_bad_input_raises_the_right_exception(small, tmp_path):
         flapssm.train(small, tmp_path / "m.json", objective="tf1")
     with pytest.raises(ValueError, match="inducing_init"):
         flapssm.train(small, tmp_path / "m.json", inducing_init="grid")
+    with pytest.raises(ValueError, match="precision"):
+        flapssm.train(small, tmp_path / "m.json", precision="f16")
     with pytest.raises(OSError, match="is a directory"):
         small.save(tmp_path)
 
@@ -132,9 +134,10 @@ def test_keyboard_interrupt_leaves_a_resumable_checkpoint(small, tmp_path):
     assert [int(r.split(",")[0]) for r in rows[2:]] == list(range(6))
 
 
-def test_kmeans_start_is_recorded(small, tmp_path):
-    model = _tiny(small, tmp_path / "k.json", inducing_init="kmeans")
-    assert json.loads(model.to_json())["training"]["spec"]["inducing_init"] == "kmeans"
+def test_kmeans_start_and_precision_are_recorded(small, tmp_path):
+    model = _tiny(small, tmp_path / "k.json", inducing_init="kmeans", precision="mixed")
+    spec = json.loads(model.to_json())["training"]["spec"]
+    assert spec["inducing_init"] == "kmeans" and spec["precision"] == "mixed"
 
 
 def test_ctrl_c_from_outside_stops_training_with_a_checkpoint(small, tmp_path):

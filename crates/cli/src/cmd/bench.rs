@@ -11,6 +11,7 @@ use flapssm_jobs::bench::{
 use flapssm_jobs::curve::{
     CONVERGED_TAIL, QUALITY_TOLERANCE, early_stop_point, read_curve, time_to_quality,
 };
+use flapssm_prssm::Precision;
 use flapssm_prssm::train::bench::REFERENCE_SOLVE_S;
 
 /// Measure training, prediction and streaming speed (release build, this machine).
@@ -38,6 +39,10 @@ pub struct BenchArgs {
     /// validation RMSE) would have ended the --train run, and what it would have kept.
     #[arg(long, value_name = "N", requires = "train", value_parser = super::positive::<usize>)]
     patience: Option<usize>,
+    /// Arithmetic of the timed training products: f64 (the reference) or mixed (the large
+    /// products in f32; docs/training.md).
+    #[arg(long, default_value = "f64")]
+    precision: Precision,
 }
 
 /// Prints the time-to-quality of `run` against `reference`.
@@ -113,6 +118,7 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
         batches: usize::from(args.batches),
         reps: args.reps,
         seed: args.seed,
+        precision: args.precision,
     })
     .context("flapssm bench")?;
     let threads = r.threads;
@@ -128,14 +134,15 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
         speed_against_reference_machine(&r)
     );
     println!(
-        "training epoch (512 seq x 470 steps x 30 particles, batch 16, {threads} threads): {:.3} s \
-         ({} batches timed), {:.1}x faster than the authors' {AUTHORS_EPOCH_S} s",
+        "training epoch (512 seq x 470 steps x 30 particles, batch 16, {threads} threads, {} precision): \
+         {:.3} s ({} batches timed), {:.1}x faster than the authors' {AUTHORS_EPOCH_S} s",
+        r.precision,
         r.epoch_s,
         r.batches,
         AUTHORS_EPOCH_S / r.epoch_s
     );
     println!(
-        "  {:.1} GFLOP/s = {:.0} % of {threads} x the GEMM rate; all FLOP at that rate: {:.2} s per epoch",
+        "  {:.1} GFLOP/s = {:.0} % of {threads} x the f64 GEMM rate; all FLOP at that rate (the f64 FLOP limit): {:.2} s per epoch",
         r.train_gflops,
         100.0 * r.train_gflops / (threads as f64 * r.gemm_gflops),
         r.flop_limit_epoch_s()

@@ -1,5 +1,6 @@
 //! `flapssm demo`: simulate, fit the LRQSM, train the PR-SSM, evaluate and report, resumably.
 
+use flapssm_prssm::Precision;
 use std::path::PathBuf;
 
 use anyhow::Context;
@@ -63,6 +64,10 @@ pub struct DemoArgs {
     /// Early stopping: end training when N evaluated epochs in a row bring no new best model.
     #[arg(long, value_name = "N", value_parser = super::positive::<u64>)]
     patience: Option<u64>,
+    /// Override the arithmetic of the ELBO's large products: f64 (the default) or mixed (those
+    /// products in f32; docs/training.md).
+    #[arg(long)]
+    precision: Option<Precision>,
     /// Override where the trajectories come from: generator (the default) or paper (the
     /// paper's measured trajectories, the default with --full; the first --trajectories).
     #[arg(long, value_enum, value_name = "SOURCE")]
@@ -117,6 +122,9 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
     }
     if args.patience.is_some() {
         cfg.training.patience = args.patience;
+    }
+    if let Some(p) = args.precision {
+        cfg.training.precision = p;
     }
     let stop = stop_flag()?;
     let bars = Bars::new();

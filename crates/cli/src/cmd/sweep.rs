@@ -1,5 +1,6 @@
 //! `flapssm sweep run|merge`: one PR-SSM configuration per process, and the merged table.
 
+use flapssm_prssm::Precision;
 use std::path::PathBuf;
 
 use anyhow::Context;
@@ -75,6 +76,10 @@ pub struct RunArgs {
     /// Early stopping: end training when N evaluated epochs in a row bring no new best model.
     #[arg(long, value_name = "N", value_parser = super::positive::<u64>)]
     patience: Option<u64>,
+    /// Arithmetic of the ELBO's large products: f64 (the reference) or mixed (those products
+    /// in f32, everything else in f64; docs/training.md).
+    #[arg(long, default_value = "f64")]
+    precision: Precision,
     /// Particles of the evaluation predictions.
     #[arg(long, default_value_t = 30)]
     eval_particles: usize,
@@ -123,6 +128,7 @@ fn run_one(a: RunArgs) -> anyhow::Result<()> {
         objective: Default::default(),
         inducing_init: a.inducing_init.map(Into::into),
         patience: a.patience,
+        precision: a.precision,
         checkpoint_every: 0,
     };
     let plan = SweepSettings {

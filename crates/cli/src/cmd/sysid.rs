@@ -1,6 +1,7 @@
 //! `flapssm sysid FILE --input COL --output COL`: the Doerr et al. system-identification
 //! protocol on a recorded input/output table (see `flapssm_jobs::sysid`).
 
+use flapssm_prssm::Precision;
 use std::path::PathBuf;
 
 use anyhow::Context;
@@ -52,6 +53,10 @@ pub struct SysidArgs {
     /// the training inputs.
     #[arg(long, value_enum, default_value = "uniform")]
     inducing_init: InducingInitArg,
+    /// Arithmetic of the ELBO's large products: f64 (the reference) or mixed (those products
+    /// in f32, everything else in f64; docs/training.md).
+    #[arg(long, default_value = "f64")]
+    precision: Precision,
     /// Also score the last parameters of each fit (not only the selected best), for diagnosis.
     #[arg(long)]
     diagnose_last: bool,
@@ -125,6 +130,7 @@ pub fn run(args: SysidArgs) -> anyhow::Result<()> {
     .with_iterations(args.iterations);
     spec.fit.train.lr = args.lr;
     spec.fit.inducing_init = args.inducing_init.into();
+    spec.fit.precision = args.precision;
     if let Some(f) = args.cosine {
         spec.fit.train.schedule = LrSchedule::Cosine { final_factor: f };
     }

@@ -1,5 +1,6 @@
 //! `flapssm train DATASET --out MODEL`: fit a PR-SSM to a flapssm dataset.
 
+use flapssm_prssm::Precision;
 use std::path::PathBuf;
 
 use anyhow::{Context, bail};
@@ -71,6 +72,10 @@ pub struct TrainArgs {
     /// Early stopping: end the run when N evaluated epochs in a row bring no new best model.
     #[arg(long, value_name = "N", value_parser = super::positive::<u64>)]
     patience: Option<u64>,
+    /// Arithmetic of the ELBO's large products: f64 (the reference) or mixed (those products
+    /// in f32, everything else in f64; docs/training.md).
+    #[arg(long, default_value = "f64")]
+    precision: Precision,
     /// Write a checkpoint every N epochs (0: only on Ctrl-C).
     #[arg(long, default_value_t = 10)]
     checkpoint_every: u64,
@@ -127,6 +132,7 @@ pub fn run(args: TrainArgs) -> anyhow::Result<()> {
         objective: args.objective.into(),
         inducing_init: args.inducing_init.map(Into::into),
         patience: args.patience,
+        precision: args.precision,
         checkpoint_every: args.checkpoint_every,
     }
     .check()?;

@@ -43,6 +43,7 @@ use crate::kernel::{self, KernelKind};
 use crate::linalg::{cholesky_backward, cholesky_in_place, gemm, lower_inverse, view, view_mut};
 use crate::objective::ObjectiveError;
 use crate::params::{CovarianceStructure, ModelConfig, Parametrization, Params};
+use crate::precision::Precision;
 
 /// Parameter-only quantities of the conditional, computed once per evaluation.
 #[derive(Debug, Clone)]
@@ -65,6 +66,11 @@ pub struct Posterior {
     /// `[G; mᵀG]`, column-major `(M + D_x) × M`, with `G = (K_mm + jitter·I)⁻¹` (unwhitened)
     /// or `L⁻¹` (whitened).
     pub(crate) g_mean: Vec<f64>,
+    /// `[G; mᵀG]` rounded to `f32` under [`Precision::Mixed`]; empty under [`Precision::F64`].
+    pub(crate) g_mean32: Vec<f32>,
+    /// Diagonal `S` (row-major `M × D_x`) rounded to `f32` under [`Precision::Mixed`]; empty
+    /// otherwise and for full `S`.
+    pub(crate) q_cov32: Vec<f32>,
     /// Diagonal: row-major `M × D_x`; full: `D_x` column-major `M × M` factors.
     pub(crate) q_cov: Vec<f64>,
     pub(crate) cov: CovarianceStructure,
@@ -155,6 +161,8 @@ impl Posterior {
             kmm_kd,
             l,
             g_mean,
+            g_mean32: Vec::new(),
+            q_cov32: Vec::new(),
             q_cov: params.q_cov.clone(),
             cov: config.covariance,
             whitened,
@@ -165,6 +173,38 @@ impl Posterior {
     #[inline]
     pub(crate) fn g_mean(&self) -> MatRef<'_, f64> {
         view(&self.g_mean, self.m + self.dx, self.m)
+    }
+
+    /// Sets the precision of the large products of the workspaces that use this cache
+    /// ([`Precision::Mixed`] rounds `[G; mᵀG]` to `f32` here, once).
+    pub fn set_precision(&mut self, precision: Precision) {
+        let round = |v: &[f64]| v.iter().map(|&x| x as f32).collect();
+        let mixed = precision == Precision::Mixed;
+        self.g_mean32 = if mixed {
+            round(&self.g_mean)
+        } else {
+            Vec::new()
+        };
+        self.q_cov32 = if mixed && self.cov == CovarianceStructure::Diagonal {
+            round(&self.q_cov)
+        } else {
+            Vec::new()
+        };
+    }
+
+    /// The precision set by [`Self::set_precision`].
+    pub fn precision(&self) -> Precision {
+        if self.g_mean32.is_empty() {
+            Precision::F64
+        } else {
+            Precision::Mixed
+        }
+    }
+
+    /// `[G; mᵀG]` in `f32` (`(M + D_x) × M`; empty unless mixed).
+    #[inline]
+    pub(crate) fn g_mean32(&self) -> MatRef<'_, f32> {
+        view(&self.g_mean32, self.m + self.dx, self.m)
     }
 
     /// The lower Cholesky factor of `K_mm + jitter·I` (column-major `M × M`).

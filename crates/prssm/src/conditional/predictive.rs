@@ -4,7 +4,7 @@ use faer::Accum;
 
 use super::Posterior;
 use crate::kernel;
-use crate::linalg::{dot, gemm, view, view_mut};
+use crate::linalg::{dot, gemm, view, view_mut, widen_into};
 use crate::params::CovarianceStructure;
 
 /// Forward-only conditional for prediction (no derivatives, no tape). `W` and the means come
@@ -79,7 +79,8 @@ impl PredictiveWorkspace {
         } else {
             Some(&self.k[..])
         };
-        write_predictive_variance(post, &self.wm, r, k, n, &mut self.w2, &mut self.var, None);
+        let (w2, var) = (&mut self.w2, &mut self.var);
+        write_predictive_variance(post, &self.wm, r, k, n, w2, var, None, None);
     }
 }
 
@@ -88,7 +89,9 @@ impl PredictiveWorkspace {
 /// `S_d = L_dL_dᵀ`), with `w_n` the first `M` entries of column `n` of `w` (column stride
 /// `stride ≥ M`) and `h_n = k_n` (column `n` of `k`, `M × N`) or `w_n` when `k` is `None`
 /// (whitened). With `quad`, also writes `σ²_d(n) − k** = Σ_i … − w_nᵀh_n` there (`D_x × N`).
-/// `w2` (`M × N`) is scratch. Allocates nothing.
+/// `w2` (`M × N`) is scratch. With `mixed` (`M × N` and `D_x × N` scratch) and a mixed
+/// posterior of diagonal `S`, the sum `S(W⊙W)` of positive terms is formed in `f32`.
+/// Allocates nothing.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn write_predictive_variance(
     post: &Posterior,
@@ -99,11 +102,28 @@ pub(super) fn write_predictive_variance(
     w2: &mut [f64],
     var: &mut [f64],
     mut quad: Option<&mut [f64]>,
+    mixed: Option<(&mut [f32], &mut [f32])>,
 ) {
     let (m, dx) = (post.m, post.dx);
     let w_view = view(&w[..stride * n], stride, n).subrows(0, m);
-    match post.cov {
-        CovarianceStructure::Diagonal => {
+    match (post.cov, mixed) {
+        (CovarianceStructure::Diagonal, Some((w2_32, var32))) if !post.q_cov32.is_empty() => {
+            for (c2, wc) in w2_32[..m * n].chunks_exact_mut(m).zip(w.chunks(stride)) {
+                c2.iter_mut().zip(&wc[..m]).for_each(|(a, &b)| {
+                    let b = b as f32;
+                    *a = b * b;
+                });
+            }
+            gemm(
+                view_mut(var32, dx, n),
+                Accum::Replace,
+                view(&post.q_cov32, dx, m),
+                view(w2_32, m, n),
+                1.0,
+            );
+            widen_into(&var32[..dx * n], var, Accum::Replace);
+        }
+        (CovarianceStructure::Diagonal, _) => {
             for (c2, wc) in w2[..m * n].chunks_exact_mut(m).zip(w.chunks(stride)) {
                 c2.iter_mut().zip(&wc[..m]).for_each(|(a, &b)| *a = b * b);
             }
@@ -115,7 +135,7 @@ pub(super) fn write_predictive_variance(
                 1.0,
             )
         }
-        CovarianceStructure::Full => {
+        (CovarianceStructure::Full, _) => {
             for dd in 0..dx {
                 let ld = &post.q_cov[dd * m * m..(dd + 1) * m * m];
                 gemm(

@@ -6,8 +6,9 @@ use faer::Accum;
 use super::Posterior;
 use super::predictive::write_predictive_variance;
 use crate::kernel;
-use crate::linalg::{dot, gemm, view, view_mut};
+use crate::linalg::{dot, gemm, round_into, view, view_mut, widen_into};
 use crate::params::CovarianceStructure;
+use crate::precision::Precision;
 
 /// Per-step values kept for the reverse mode: the scaled inputs `X̃` (`D × N`),
 /// `σ_f² g'` (`M × N`), `[W; μ]` (`(M + D_x) × N`) and `σ² − σ_f²` (`D_x × N`), stored in one
@@ -58,6 +59,42 @@ pub struct ConditionalWorkspace {
     pub mean: Vec<f64>,
     /// Variances `σ²`, column-major `D_x × N`.
     pub var: Vec<f64>,
+    /// `f32` operands and results of the large products under [`Precision::Mixed`].
+    mixed: Option<MixedBuffers>,
+}
+
+/// The `f32` side of the three large products of a step ([`crate::precision`]).
+#[derive(Debug, Clone)]
+struct MixedBuffers {
+    /// `K` (`M × N`).
+    k: Vec<f32>,
+    /// `[W; μ]` (`(M + D_x) × N`).
+    wm: Vec<f32>,
+    /// `[P; μ̄]`, then `[A; μ̄]` (`(M + D_x) × N`).
+    wbar: Vec<f32>,
+    /// `Y` (`M × N`).
+    y: Vec<f32>,
+    /// This step's `[A; μ̄] Wᵀ` (`(M + D_x) × M`).
+    gbar: Vec<f32>,
+    /// `σ²` (forward) or `σ̄²` (reverse), `D_x × N`.
+    var: Vec<f32>,
+    /// This step's `σ̄²(W⊙W)ᵀ` (`D_x × M`, diagonal `S`).
+    q_cov_bar: Vec<f32>,
+}
+
+impl MixedBuffers {
+    fn new(m: usize, dx: usize, n: usize) -> Self {
+        let r = m + dx;
+        Self {
+            k: vec![0.0; m * n],
+            wm: vec![0.0; r * n],
+            wbar: vec![0.0; r * n],
+            y: vec![0.0; m * n],
+            gbar: vec![0.0; r * m],
+            var: vec![0.0; dx * n],
+            q_cov_bar: vec![0.0; dx * m],
+        }
+    }
 }
 
 /// Chunk-local gradient accumulators of the conditional.
@@ -114,9 +151,11 @@ impl ConditionalGrads {
 }
 
 impl ConditionalWorkspace {
-    /// Buffers for up to `capacity` points.
+    /// Buffers for up to `capacity` points, in the precision of `post`
+    /// ([`Posterior::set_precision`]).
     pub fn new(post: &Posterior, capacity: usize) -> Self {
         let (m, d, dx, n) = (post.m, post.d, post.dx, capacity);
+        let mixed = (post.precision() == Precision::Mixed).then(|| MixedBuffers::new(m, dx, n));
         Self {
             cap: n,
             input: vec![0.0; d * n],
@@ -132,7 +171,13 @@ impl ConditionalWorkspace {
             input_group: 1,
             mean: vec![0.0; dx * n],
             var: vec![0.0; dx * n],
+            mixed,
         }
+    }
+
+    /// Whether the buffers serve `post`: the capacity is `n` and the precision `post`'s.
+    pub(crate) fn fits(&self, post: &Posterior, n: usize) -> bool {
+        self.cap == n && self.mixed.is_some() == (post.precision() == Precision::Mixed)
     }
 
     /// Declares that consecutive groups of `group` points share the input part `u` of
@@ -175,13 +220,26 @@ impl ConditionalWorkspace {
             &mut self.rowsum,
         );
         let r = m + dx;
-        gemm(
-            view_mut(t.wm, r, n),
-            Accum::Replace,
-            post.g_mean(),
-            view(k, m, n),
-            1.0,
-        );
+        match self.mixed.as_mut() {
+            None => gemm(
+                view_mut(t.wm, r, n),
+                Accum::Replace,
+                post.g_mean(),
+                view(k, m, n),
+                1.0,
+            ),
+            Some(mx) => {
+                round_into(k, &mut mx.k);
+                gemm(
+                    view_mut(&mut mx.wm, r, n),
+                    Accum::Replace,
+                    post.g_mean32(),
+                    view(&mx.k, m, n),
+                    1.0,
+                );
+                widen_into(&mx.wm[..r * n], t.wm, Accum::Replace);
+            }
+        }
         let wm = &*t.wm;
         for (mean, col) in self.mean[..dx * n]
             .chunks_exact_mut(dx)
@@ -190,7 +248,12 @@ impl ConditionalWorkspace {
             mean.copy_from_slice(&col[m..]);
         }
         let h = if post.whitened { None } else { Some(&*k) };
-        write_predictive_variance(post, wm, r, h, n, &mut self.w2, &mut self.var, Some(t.quad));
+        let mixed = self
+            .mixed
+            .as_mut()
+            .map(|mx| (&mut mx.k[..], &mut mx.var[..]));
+        let (w2, var) = (&mut self.w2, &mut self.var);
+        write_predictive_variance(post, wm, r, h, n, w2, var, Some(t.quad), mixed);
     }
 
     /// Reverse mode of the last [`Self::forward`] on `n` points: given `mean_bar`, `var_bar`
@@ -242,8 +305,45 @@ impl ConditionalWorkspace {
         }
         let kbar = &mut self.kbar[..m * n];
         let whitened = post.whitened;
-        match post.cov {
-            CovarianceStructure::Diagonal => {
+        match (post.cov, self.mixed.as_mut()) {
+            (CovarianceStructure::Diagonal, Some(mx)) => {
+                // As below, the three D_x-row products in f32 (S, σ̄², W⊙W ≥ 0 or of one sign).
+                round_into(&var_bar[..dx * n], &mut mx.var);
+                gemm(
+                    view_mut(&mut mx.y, m, n),
+                    Accum::Replace,
+                    view(&post.q_cov32, dx, m).transpose(),
+                    view(&mx.var, dx, n),
+                    1.0,
+                );
+                let cols = mx.k[..m * n]
+                    .chunks_exact_mut(m)
+                    .zip(wbar.chunks_exact_mut(r))
+                    .zip(mx.y.chunks_exact(m))
+                    .zip(wm.chunks_exact(r))
+                    .zip(&self.base_bar[..n]);
+                for ((((w2, pc), vc), wc), &bb) in cols {
+                    let (pc, wc) = (&mut pc[..m], &wc[..m]);
+                    let s = -2.0 * bb;
+                    for (((w2, p), &v), &wv) in w2.iter_mut().zip(pc.iter_mut()).zip(vc).zip(wc) {
+                        let w32 = wv as f32;
+                        *w2 = w32 * w32;
+                        *p = 2.0 * wv * f64::from(v);
+                        if whitened {
+                            *p += s * wv;
+                        }
+                    }
+                }
+                gemm(
+                    view_mut(&mut mx.q_cov_bar, dx, m),
+                    Accum::Replace,
+                    view(&mx.var, dx, n),
+                    view(&mx.k, m, n).transpose(),
+                    1.0,
+                );
+                widen_into(&mx.q_cov_bar, &mut grads.q_cov, Accum::Add);
+            }
+            (CovarianceStructure::Diagonal, None) => {
                 // `V = Sᵀσ̄²`, then one pass: `W⊙W` and `P = 2 W⊙V` (whitened: `− 2β̄W`).
                 gemm(
                     view_mut(kbar, m, n),
@@ -277,7 +377,7 @@ impl ConditionalWorkspace {
                     1.0,
                 );
             }
-            CovarianceStructure::Full => {
+            (CovarianceStructure::Full, _) => {
                 for col in wbar.chunks_exact_mut(r) {
                     col[..m].fill(0.0);
                 }
@@ -328,13 +428,26 @@ impl ConditionalWorkspace {
             }
         }
         // Y = [G; mᵀG]ᵀ [P; μ̄]; then A (into the top rows of `wbar`) and K̄ (into `kbar`).
-        gemm(
-            view_mut(kbar, m, n),
-            Accum::Replace,
-            post.g_mean().transpose(),
-            view(wbar, r, n),
-            1.0,
-        );
+        match self.mixed.as_mut() {
+            None => gemm(
+                view_mut(kbar, m, n),
+                Accum::Replace,
+                post.g_mean().transpose(),
+                view(wbar, r, n),
+                1.0,
+            ),
+            Some(mx) => {
+                round_into(wbar, &mut mx.wbar);
+                gemm(
+                    view_mut(&mut mx.y, m, n),
+                    Accum::Replace,
+                    post.g_mean32().transpose(),
+                    view(&mx.wbar, r, n),
+                    1.0,
+                );
+                widen_into(&mx.y[..m * n], kbar, Accum::Replace);
+            }
+        }
         let cols = wbar
             .chunks_exact_mut(r)
             .zip(kbar.chunks_exact_mut(m))
@@ -352,13 +465,27 @@ impl ConditionalWorkspace {
             }
         }
         // [B; m̄ᵀ] += [A; μ̄] Wᵀ.
-        gemm(
-            view_mut(&mut grads.gbar, r, m),
-            Accum::Add,
-            view(wbar, r, n),
-            w_view.transpose(),
-            1.0,
-        );
+        match self.mixed.as_mut() {
+            None => gemm(
+                view_mut(&mut grads.gbar, r, m),
+                Accum::Add,
+                view(wbar, r, n),
+                w_view.transpose(),
+                1.0,
+            ),
+            Some(mx) => {
+                round_into(wbar, &mut mx.wbar);
+                round_into(wm, &mut mx.wm);
+                gemm(
+                    view_mut(&mut mx.gbar, r, m),
+                    Accum::Replace,
+                    view(&mx.wbar, r, n),
+                    view(&mx.wm, r, n).subrows(0, m).transpose(),
+                    1.0,
+                );
+                widen_into(&mx.gbar, &mut grads.gbar, Accum::Add);
+            }
+        }
         // ∂/∂σ_f² through K = σ_f² g: Σ K̄⊙K / σ_f², with Σ K̄⊙K = Σ μ̄⊙μ + 2 Σ σ̄²⊙(σ² − σ_f²).
         let mut euler = 0.0;
         for (((mb, col), vb), q) in mean_bar

@@ -170,7 +170,7 @@ impl<'a> Chunk<'a> {
         let mut sds = std::mem::take(&mut scratch.sds);
         sds.resize(self.n_steps * self.step, 0.0);
         let mut ws = match scratch.ws.take() {
-            Some(ws) if ws.capacity() == n => ws,
+            Some(ws) if ws.fits(self.post, n) => ws,
             _ => ConditionalWorkspace::new(self.post, n),
         };
         ws.set_input_group(self.np);

@@ -26,6 +26,7 @@ use crate::kernel;
 use crate::kl::kl_divergence;
 use crate::objective::{Objective, ObjectiveError, Window};
 use crate::params::{ConfigError, ModelConfig, ParamGrads, Parametrization, Params};
+use crate::precision::Precision;
 use crate::tape::TapeMemory;
 
 mod chunk;
@@ -253,6 +254,7 @@ pub struct Elbo {
     data: TrainingData,
     options: ElboOptions,
     tape_budget_bytes: usize,
+    precision: Precision,
     scratch: ScratchPool,
 }
 
@@ -353,6 +355,7 @@ impl Elbo {
             data,
             options,
             tape_budget_bytes: TAPE_BUDGET_BYTES,
+            precision: Precision::F64,
             scratch: ScratchPool::default(),
         })
     }
@@ -373,6 +376,18 @@ impl Elbo {
     pub fn with_tape_budget(mut self, bytes: usize) -> Self {
         self.tape_budget_bytes = bytes;
         self
+    }
+
+    /// Sets the arithmetic of the large products (default [`Precision::F64`]; see
+    /// [`crate::precision`]).
+    pub fn with_precision(mut self, precision: Precision) -> Self {
+        self.precision = precision;
+        self
+    }
+
+    /// The arithmetic of the large products.
+    pub fn precision(&self) -> Precision {
+        self.precision
     }
 
     /// The training data.
@@ -461,7 +476,8 @@ impl Elbo {
         let cfg = &self.config;
         let p = Params::from_unconstrained(cfg, params)
             .map_err(|e| ObjectiveError::Shape(e.to_string()))?;
-        let post = Posterior::new(cfg, &p)?;
+        let mut post = Posterior::new(cfg, &p)?;
+        post.set_precision(self.precision);
         let lik_scale = match self.options.scaling {
             LossScaling::Standard { n_windows } => {
                 n_windows / (b_n.max(1) * self.options.particles) as f64

@@ -38,6 +38,7 @@ use crate::elbo::{
 use crate::kernel::KernelKind;
 use crate::model::{Normalization, PrssmModel};
 use crate::params::{ConfigError, ModelConfig, ParamInit, Params};
+use crate::precision::Precision;
 use crate::predict::{self, Prediction};
 use crate::{Objective, ObjectiveError};
 
@@ -121,6 +122,9 @@ pub struct FitSpec {
     /// How `Z` and the `q(u)` means start (older specs: uniform).
     #[serde(default)]
     pub inducing_init: InducingInit,
+    /// Arithmetic of the ELBO's large products (older specs: f64; [`crate::precision`]).
+    #[serde(default)]
+    pub precision: Precision,
 }
 
 impl FitSpec {
@@ -145,6 +149,7 @@ impl FitSpec {
                 eval_max_sequences: 16,
                 objective: ObjectiveForm::Standard,
                 inducing_init: InducingInit::Uniform,
+                precision: Precision::F64,
             },
             Preset::Sysid => {
                 let mut model = ModelConfig::new(4.max(n_output), n_output, n_input, 20);
@@ -171,6 +176,7 @@ impl FitSpec {
                     eval_max_sequences: 16,
                     objective: ObjectiveForm::Standard,
                     inducing_init: InducingInit::Uniform,
+                    precision: Precision::F64,
                 }
             }
         }
@@ -405,7 +411,7 @@ pub fn fit(
         },
         windows_per_task: 4,
     };
-    let elbo = Elbo::new(cfg.clone(), data, options)?;
+    let elbo = Elbo::new(cfg.clone(), data, options)?.with_precision(spec.precision);
     let train_z = elbo.data().sequences();
     let seed = spec.train.seed;
     let mut start = Params::init(cfg, &spec.init, derive_seed(seed, 3, 0));

@@ -172,6 +172,7 @@ def train(
     objective: str = "standard",
     inducing_init: Optional[str] = None,
     patience: Optional[int] = None,
+    precision: str = "f64",
 ) -> "_native.Prssm":
     """Trains a PR-SSM (``flapssm train``) on the dataset's training trajectories; writes
     the best model to ``out``, the last to ``<out>.last.json``, checkpoints to
@@ -183,11 +184,13 @@ def train(
     ``"standard"`` (the unbiased ELBO) or ``"published-code"`` (the authors' objective and
     shared noise draws, to re-run their exact training). ``inducing_init``: ``"uniform"``
     or ``"kmeans"`` (default: the preset's). ``patience``: end when that many evaluated
-    epochs in a row bring no new best model."""
+    epochs in a row bring no new best model. ``precision``: ``"f64"`` (the reference) or
+    ``"mixed"`` (the ELBO's large products in f32)."""
     return _native.train(
         dataset, os.fspath(out), preset, dx, inducing, particles, epochs, iterations, batch,
         lr, int(seed), float(val_fraction), int(checkpoint_every), bool(resume), progress,
         best_by, objective, inducing_init, None if patience is None else int(patience),
+        precision,
     )
 
 

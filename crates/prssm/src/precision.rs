@@ -1,0 +1,56 @@
+//! The arithmetic precision of the ELBO's large products.
+//!
+//! [`Precision::Mixed`] runs the three `(M + D_x) × M × N` products of every transition step in
+//! `f32`, where they cost twice as much per FLOP in `f64`:
+//!
+//! ```text
+//! forward   [W; μ]      = [G; mᵀG] K
+//! reverse   Y           = [G; mᵀG]ᵀ [P; μ̄]
+//!           [B; m̄ᵀ]    += [A; μ̄] Wᵀ
+//! ```
+//!
+//! Their operands are rounded to `f32` (`[G; mᵀG]` once per evaluation, the others per step),
+//! the products are formed in `f32`, and their results are widened back: the first two feed
+//! `f64` code, the third is added to its `f64` sum over steps. Everything else stays `f64`:
+//! the kernel, the factorization of `K_mm`, `G`, the predictive variances
+//! `σ² = σ_f² − Σ H⊙W + S(W⊙W)` (from the widened `W`), the KL, the likelihood, the draws and
+//! every reduction. The variance's cancellation sees `W`'s `f32` rounding, so a variance can come
+//! out below zero by about `2⁻²⁴ Σ|H||W|`; the transition adds `σ_x² + δ` to it, and a step
+//! whose total is not positive gives a non-finite loss, which the trainer's divergence guard
+//! rejects like any other.
+//!
+//! [`Precision::F64`] is the reference; `tests/mixed_precision.rs` measures the difference.
+
+use serde::{Deserialize, Serialize};
+
+/// Arithmetic of the ELBO's large products (see the module docs).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Precision {
+    /// Everything in `f64` (the reference).
+    #[default]
+    F64,
+    /// The three large products of each step in `f32`, the rest in `f64`.
+    Mixed,
+}
+
+impl std::str::FromStr for Precision {
+    type Err = String;
+    /// `f64` or `mixed` (the command line's and the bindings' spelling).
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "f64" => Ok(Precision::F64),
+            "mixed" => Ok(Precision::Mixed),
+            _ => Err(format!("unknown precision {s:?} (expected f64 or mixed)")),
+        }
+    }
+}
+
+impl std::fmt::Display for Precision {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Precision::F64 => "f64",
+            Precision::Mixed => "mixed",
+        })
+    }
+}
