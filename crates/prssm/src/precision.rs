@@ -9,12 +9,14 @@
 //!           [B; m̄ᵀ]    += [A; μ̄] Wᵀ
 //! ```
 //!
-//! Their operands are rounded to `f32` (`[G; mᵀG]` once per evaluation, the others per step),
-//! the products are formed in `f32`, and their results are widened back: the first two feed
-//! `f64` code, the third is added to its `f64` sum over steps. Everything else stays `f64`:
-//! the kernel, the factorization of `K_mm`, `G`, the predictive variances
-//! `σ² = σ_f² − Σ H⊙W + S(W⊙W)` (from the widened `W`), the KL, the likelihood, the draws and
-//! every reduction. The variance's cancellation sees `W`'s `f32` rounding, so a variance can come
+//! and, for diagonal `S`, the three `D_x`-row products `S(W⊙W)`, `Sᵀσ̄²` and `σ̄²(W⊙W)ᵀ`
+//! (sums of terms of one sign, or one sign per factor, so `f32` loses no more than its rounding).
+//! Their operands are rounded to `f32` (`[G; mᵀG]` and `S` once per evaluation, the others per
+//! step), the products are formed in `f32`, and their results are widened back: most feed `f64`
+//! code, the parameter adjoints are added to their `f64` sums over steps. Everything else stays
+//! `f64`: the kernel, the factorization of `K_mm`, `G`, the cancellation `σ_f² − Σ H⊙W` of the
+//! predictive variance (from the widened `W`), the KL, the likelihood, the draws and every
+//! reduction. The variance's cancellation sees `W`'s `f32` rounding, so a variance can come
 //! out below zero by about `2⁻²⁴ Σ|H||W|`; the transition adds `σ_x² + δ` to it, and a step
 //! whose total is not positive gives a non-finite loss, which the trainer's divergence guard
 //! rejects like any other.
