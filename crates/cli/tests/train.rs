@@ -381,6 +381,55 @@ fn the_precision_is_selectable_and_recorded() {
     assert!(err.contains("f64") && err.contains("mixed"), "{err}");
 }
 
+/// `--windows-per-task N` is recorded in the model file and changes the first-epoch loss only
+/// by rounding (the same draws, summed in other tasks); a checkpoint of one task size is not
+/// resumed with another; 0 is refused naming the flag.
+#[test]
+fn the_task_size_is_recorded_and_changes_only_rounding() {
+    let dir = tempfile::tempdir().unwrap();
+    let data = simulated(dir.path(), 2, 3);
+    let loss_of = |per_task: &str| {
+        let out = dir.path().join(format!("t{per_task}.json"));
+        let mut args = train_args(&data, &out, "1");
+        args.extend(["--windows-per-task", per_task, "--val-fraction", "0"]);
+        ok(&args);
+        let model = json(&out)["model"].clone();
+        assert_eq!(
+            model["training"]["spec"]["windows_per_task"].as_u64(),
+            per_task.parse().ok()
+        );
+        model["training"]["history"][0]["mean_loss"]
+            .as_f64()
+            .unwrap()
+    };
+    let (one, four) = (loss_of("1"), loss_of("4"));
+    assert!(
+        (one - four).abs() <= 1e-6 * four.abs(),
+        "1 per task {one}, 4 per task {four}"
+    );
+
+    let ckpt = dir.path().join("t1.ckpt.json");
+    let out = dir.path().join("r.json");
+    let mut args = train_args(&data, &out, "2");
+    args.extend([
+        "--windows-per-task",
+        "4",
+        "--val-fraction",
+        "0",
+        "--resume",
+        "--checkpoint",
+    ]);
+    args.push(s(&ckpt));
+    assert_fails(&flapssm(&args), &["run_context.fit"], &out);
+
+    let mut args = train_args(&data, &out, "1");
+    args.extend(["--windows-per-task", "0"]);
+    let o = flapssm(&args);
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("--windows-per-task"), "{err}");
+}
+
 /// `--patience N` ends the run once N evaluated epochs in a row bring no new best model, and
 /// says so; the model files are written as for a whole run.
 #[test]

@@ -60,6 +60,10 @@ pub struct TrainingOptions {
     /// Arithmetic of the ELBO's large products (f64, the reference, or mixed).
     #[serde(default)]
     pub precision: Precision,
+    /// Windows per parallel task of the ELBO (the preset's 4 when `None`): a minibatch of `B`
+    /// windows keeps at most `⌈B / n⌉` threads busy.
+    #[serde(default)]
+    pub windows_per_task: Option<usize>,
     /// Checkpoint every this many epochs (0: only when interrupted).
     pub checkpoint_every: u64,
 }
@@ -85,6 +89,7 @@ impl Default for TrainingOptions {
             inducing_init: None,
             patience: None,
             precision: Precision::F64,
+            windows_per_task: None,
             checkpoint_every: 10,
         }
     }
@@ -129,6 +134,9 @@ impl TrainingOptions {
             spec.train.patience = self.patience;
         }
         spec.precision = self.precision;
+        if let Some(v) = self.windows_per_task {
+            spec.windows_per_task = v;
+        }
         spec.train.seed = self.seed;
         spec.train.checkpoint_every = self.checkpoint_every;
         spec.train.best_by = self.best_by;
@@ -160,6 +168,7 @@ impl TrainingOptions {
             ("inducing", self.inducing),
             ("particles", self.particles),
             ("batch", self.batch),
+            ("windows_per_task", self.windows_per_task),
         ] {
             if v == Some(0) {
                 return bad(name, "0".into(), "must be at least 1");

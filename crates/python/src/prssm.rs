@@ -218,7 +218,8 @@ impl Stream {
 #[pyo3(signature = (dataset, out, preset="paper", dx=None, inducing=None, particles=None,
     epochs=None, iterations=None, batch=None, lr=None, seed=0, val_fraction=0.1,
     checkpoint_every=10, resume=false, progress=None, best_by="rmse",
-    objective="standard", inducing_init=None, patience=None, precision="f64"))]
+    objective="standard", inducing_init=None, patience=None, precision="f64",
+    windows_per_task=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn train(
     py: Python<'_>,
@@ -242,6 +243,7 @@ pub fn train(
     inducing_init: Option<&str>,
     patience: Option<u64>,
     precision: &str,
+    windows_per_task: Option<usize>,
 ) -> PyResult<Prssm> {
     let best_by: flapssm_prssm::train::BestBy = best_by
         .parse()
@@ -276,6 +278,7 @@ pub fn train(
         inducing_init,
         patience,
         precision,
+        windows_per_task,
         checkpoint_every,
     }
     .check()

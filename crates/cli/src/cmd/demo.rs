@@ -68,6 +68,11 @@ pub struct DemoArgs {
     /// products in f32; docs/training.md).
     #[arg(long)]
     precision: Option<Precision>,
+    /// Windows (sequences) per parallel task of the ELBO: a minibatch of B windows keeps at
+    /// most ceil(B / N) threads busy (default 4: batch 16 fills 4 cores); results depend on the
+    /// thread count not at all, on N only in the last bits (docs/training.md).
+    #[arg(long, value_name = "N", value_parser = super::positive::<usize>)]
+    windows_per_task: Option<usize>,
     /// Override where the trajectories come from: generator (the default) or paper (the
     /// paper's measured trajectories, the default with --full; the first --trajectories).
     #[arg(long, value_enum, value_name = "SOURCE")]
@@ -125,6 +130,9 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
     }
     if let Some(p) = args.precision {
         cfg.training.precision = p;
+    }
+    if args.windows_per_task.is_some() {
+        cfg.training.windows_per_task = args.windows_per_task;
     }
     let stop = stop_flag()?;
     let bars = Bars::new();

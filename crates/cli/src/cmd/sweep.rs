@@ -80,6 +80,11 @@ pub struct RunArgs {
     /// in f32, everything else in f64; docs/training.md).
     #[arg(long, default_value = "f64")]
     precision: Precision,
+    /// Windows (sequences) per parallel task of the ELBO: a minibatch of B windows keeps at
+    /// most ceil(B / N) threads busy (default 4: batch 16 fills 4 cores); results depend on the
+    /// thread count not at all, on N only in the last bits (docs/training.md).
+    #[arg(long, value_name = "N", value_parser = super::positive::<usize>)]
+    windows_per_task: Option<usize>,
     /// Particles of the evaluation predictions.
     #[arg(long, default_value_t = 30)]
     eval_particles: usize,
@@ -129,6 +134,7 @@ fn run_one(a: RunArgs) -> anyhow::Result<()> {
         inducing_init: a.inducing_init.map(Into::into),
         patience: a.patience,
         precision: a.precision,
+        windows_per_task: a.windows_per_task,
         checkpoint_every: 0,
     };
     let plan = SweepSettings {

@@ -76,6 +76,11 @@ pub struct TrainArgs {
     /// in f32, everything else in f64; docs/training.md).
     #[arg(long, default_value = "f64")]
     precision: Precision,
+    /// Windows (sequences) per parallel task of the ELBO: a minibatch of B windows keeps at
+    /// most ceil(B / N) threads busy (default 4: batch 16 fills 4 cores); results depend on the
+    /// thread count not at all, on N only in the last bits (docs/training.md).
+    #[arg(long, value_name = "N", value_parser = super::positive::<usize>)]
+    windows_per_task: Option<usize>,
     /// Write a checkpoint every N epochs (0: only on Ctrl-C).
     #[arg(long, default_value_t = 10)]
     checkpoint_every: u64,
@@ -133,6 +138,7 @@ pub fn run(args: TrainArgs) -> anyhow::Result<()> {
         inducing_init: args.inducing_init.map(Into::into),
         patience: args.patience,
         precision: args.precision,
+        windows_per_task: args.windows_per_task,
         checkpoint_every: args.checkpoint_every,
     }
     .check()?;

@@ -701,5 +701,24 @@ mod tests {
         }
         // A repeated evaluation reuses the pooled buffers.
         assert_eq!(run(&elbo), full);
+        // Other task sizes draw the same numbers (per window) and sum in another order: the
+        // same loss and gradient up to rounding, and not bit for bit (the sizes are real).
+        let mut differs = false;
+        for per_task in [1, 3] {
+            let mut o = elbo.options().clone();
+            o.windows_per_task = per_task;
+            let e = Elbo::new(elbo.config().clone(), elbo.data().clone(), o).unwrap();
+            let (loss, g) = run(&e);
+            assert!(
+                (loss - full.0).abs() <= 1e-12 * full.0.abs(),
+                "{per_task}: {loss}"
+            );
+            let scale = full.1.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+            for (a, b) in g.iter().zip(&full.1) {
+                assert!((a - b).abs() <= 1e-11 * scale, "{per_task}: {a} vs {b}");
+            }
+            differs |= (loss, g) != full;
+        }
+        assert!(differs, "the task size changed nothing at all");
     }
 }

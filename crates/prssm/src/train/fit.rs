@@ -125,6 +125,19 @@ pub struct FitSpec {
     /// Arithmetic of the ELBO's large products (older specs: f64; [`crate::precision`]).
     #[serde(default)]
     pub precision: Precision,
+    /// Windows batched into one parallel task of the ELBO ([`ElboOptions::windows_per_task`];
+    /// older specs: 4). A minibatch of `B` windows runs as `⌈B / n⌉` tasks, so at most that
+    /// many threads work on it; the result does not depend on the thread count, and on `n`
+    /// only through the order of floating-point sums.
+    #[serde(default = "default_windows_per_task")]
+    pub windows_per_task: usize,
+}
+
+/// [`FitSpec::windows_per_task`] of the presets and of specs written before it existed.
+pub const DEFAULT_WINDOWS_PER_TASK: usize = 4;
+
+fn default_windows_per_task() -> usize {
+    DEFAULT_WINDOWS_PER_TASK
 }
 
 impl FitSpec {
@@ -150,6 +163,7 @@ impl FitSpec {
                 objective: ObjectiveForm::Standard,
                 inducing_init: InducingInit::Uniform,
                 precision: Precision::F64,
+                windows_per_task: DEFAULT_WINDOWS_PER_TASK,
             },
             Preset::Sysid => {
                 let mut model = ModelConfig::new(4.max(n_output), n_output, n_input, 20);
@@ -177,6 +191,7 @@ impl FitSpec {
                     objective: ObjectiveForm::Standard,
                     inducing_init: InducingInit::Uniform,
                     precision: Precision::F64,
+                    windows_per_task: DEFAULT_WINDOWS_PER_TASK,
                 }
             }
         }
@@ -409,7 +424,7 @@ pub fn fit(
             InitialStateSpec::Outputs => InitialStateMode::Outputs,
             _ => InitialStateMode::Zeros,
         },
-        windows_per_task: 4,
+        windows_per_task: spec.windows_per_task,
     };
     let elbo = Elbo::new(cfg.clone(), data, options)?.with_precision(spec.precision);
     let train_z = elbo.data().sequences();

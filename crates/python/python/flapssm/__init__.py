@@ -173,6 +173,7 @@ def train(
     inducing_init: Optional[str] = None,
     patience: Optional[int] = None,
     precision: str = "f64",
+    windows_per_task: Optional[int] = None,
 ) -> "_native.Prssm":
     """Trains a PR-SSM (``flapssm train``) on the dataset's training trajectories; writes
     the best model to ``out``, the last to ``<out>.last.json``, checkpoints to
@@ -185,12 +186,14 @@ def train(
     shared noise draws, to re-run their exact training). ``inducing_init``: ``"uniform"``
     or ``"kmeans"`` (default: the preset's). ``patience``: end when that many evaluated
     epochs in a row bring no new best model. ``precision``: ``"f64"`` (the reference) or
-    ``"mixed"`` (the ELBO's large products in f32)."""
+    ``"mixed"`` (the ELBO's large products in f32). ``windows_per_task``: sequences per
+    parallel task (default 4; a minibatch of ``batch`` keeps at most ``batch / n`` threads
+    busy; results change only in the last bits)."""
     return _native.train(
         dataset, os.fspath(out), preset, dx, inducing, particles, epochs, iterations, batch,
         lr, int(seed), float(val_fraction), int(checkpoint_every), bool(resume), progress,
         best_by, objective, inducing_init, None if patience is None else int(patience),
-        precision,
+        precision, None if windows_per_task is None else int(windows_per_task),
     )
 
 
