@@ -7,7 +7,7 @@ use flapssm_prssm::train::bench::{
     REFERENCE_SOLVE_S, gemm_rate_gflops, initial_model, predict_step_flops,
     reference_solve_seconds, synthetic_objective, time_batches, time_prediction, time_stream_step,
 };
-use flapssm_prssm::train::fit::{FitError, FitSpec, Preset};
+use flapssm_prssm::train::fit::{DEFAULT_WINDOWS_PER_TASK, FitError, FitSpec, Preset};
 
 use crate::error::{JobError, Result};
 use crate::threads::current_threads;
@@ -34,6 +34,8 @@ pub struct BenchSettings {
     pub seed: u64,
     /// Arithmetic of the training products.
     pub precision: Precision,
+    /// Windows per parallel task of the timed minibatches ([`FitSpec::windows_per_task`]).
+    pub windows_per_task: usize,
 }
 
 impl Default for BenchSettings {
@@ -43,6 +45,7 @@ impl Default for BenchSettings {
             reps: 9,
             seed: 0,
             precision: Precision::F64,
+            windows_per_task: DEFAULT_WINDOWS_PER_TASK,
         }
     }
 }
@@ -52,6 +55,8 @@ impl Default for BenchSettings {
 pub struct BenchReport {
     /// Arithmetic of the timed training products.
     pub precision: Precision,
+    /// Windows per parallel task of the timed minibatches.
+    pub windows_per_task: usize,
     /// Threads of the pool the training ran on.
     pub threads: usize,
     /// f64 GEMM rate (512³, faer, one thread), GFLOP/s.
@@ -107,7 +112,17 @@ pub fn bench(settings: &BenchSettings) -> Result<BenchReport> {
         what: format!("bench: {what}"),
         source,
     };
-    let spec = FitSpec::preset(Preset::Paper, 7, 5);
+    if settings.windows_per_task == 0 {
+        return Err(JobError::Setting {
+            name: "windows_per_task".into(),
+            value: "0".into(),
+            expected: "must be at least 1".into(),
+        });
+    }
+    let spec = FitSpec {
+        windows_per_task: settings.windows_per_task,
+        ..FitSpec::preset(Preset::Paper, 7, 5)
+    };
     let gemm_gflops = gemm_rate_gflops(512, 0.3);
     let reference_solve_s = reference_solve_seconds(0.2);
     let (elbo, params) = synthetic_objective(&spec, TRAIN_SEQUENCES, PREDICT_STEPS, settings.seed)
@@ -117,13 +132,20 @@ pub fn bench(settings: &BenchSettings) -> Result<BenchReport> {
         .map_err(|e| engine("timing training batches", e.into()))?;
     let per_epoch = BATCHES_PER_EPOCH as f64 / settings.batches as f64;
     let model = initial_model(&spec, settings.seed);
-    let predict_s = time_prediction(&model, PREDICT_STEPS, spec.particles, settings.reps)
-        .map_err(|e| engine("timing prediction", e.into()))?;
+    let predict_s = time_prediction(
+        &model,
+        PREDICT_STEPS,
+        spec.particles,
+        settings.reps,
+        settings.precision,
+    )
+    .map_err(|e| engine("timing prediction", e.into()))?;
     let step_flops = predict_step_flops(&model.config, spec.particles);
-    let stream_step_s = time_stream_step(&model, spec.particles, 2000)
+    let stream_step_s = time_stream_step(&model, spec.particles, 2000, settings.precision)
         .map_err(|e| engine("timing streaming", e.into()))?;
     Ok(BenchReport {
         precision: settings.precision,
+        windows_per_task: settings.windows_per_task,
         threads: current_threads(),
         gemm_gflops,
         reference_solve_s,

@@ -32,13 +32,29 @@ pub(crate) fn gemm<T: ComplexField>(
     matmul(dst, accum, lhs, rhs, alpha, Par::Seq);
 }
 
-/// `dst[i] = src[i] as f32` over `src` (round to nearest).
+/// Magnitude below which an `f32` operand of a product is taken as zero: `2⁻⁶²`, so that the
+/// product of two nonzero operands (`≥ 2⁻¹²⁴`) is a normal `f32`. Subnormal operands or results
+/// slow the `f32` kernels down many times over; what is flushed is below `2⁻⁶²` in absolute
+/// terms, far under `f32`'s rounding of the standardized values these products see.
+pub(crate) const F32_OPERAND_FLOOR: f64 = 2.168_404_344_971_009e-19;
+
+/// `x` rounded to `f32` as a product operand: zero below [`F32_OPERAND_FLOOR`] in magnitude.
+#[inline(always)]
+pub(crate) fn f32_operand(x: f64) -> f32 {
+    if x.abs() < F32_OPERAND_FLOOR {
+        0.0
+    } else {
+        x as f32
+    }
+}
+
+/// `dst[i] = f32_operand(src[i])` over `src` (round to nearest, tiny values to zero).
 #[inline]
 pub(crate) fn round_into(src: &[f64], dst: &mut [f32]) {
     dst[..src.len()]
         .iter_mut()
         .zip(src)
-        .for_each(|(d, &s)| *d = s as f32);
+        .for_each(|(d, &s)| *d = f32_operand(s));
 }
 
 /// `dst[i] = src[i]` (`accum = Replace`) or `dst[i] += src[i]` (`Add`), widened to `f64`.
@@ -199,6 +215,21 @@ mod tests {
             }
         }
         a
+    }
+
+    /// Operands below the floor become zero, all others round to nearest; the product of any
+    /// two nonzero operands is a normal `f32` (no subnormal reaches the `f32` kernels).
+    #[test]
+    fn f32_operands_are_zero_or_large_enough_for_normal_products() {
+        assert_eq!(f32_operand(0.99 * F32_OPERAND_FLOOR), 0.0);
+        assert_eq!(f32_operand(-1e-30), 0.0);
+        assert_eq!(f32_operand(F32_OPERAND_FLOOR), F32_OPERAND_FLOOR as f32);
+        assert_eq!(f32_operand(-0.1), -0.1f32);
+        let smallest = f32_operand(F32_OPERAND_FLOOR);
+        assert!((smallest * smallest).is_normal());
+        let mut dst = [1.0f32; 3];
+        round_into(&[1e-25, 2.5, -3e-20], &mut dst);
+        assert_eq!(dst, [0.0, 2.5, 0.0]);
     }
 
     #[test]

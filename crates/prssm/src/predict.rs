@@ -12,6 +12,7 @@ use serde::{Deserialize, Serialize};
 use crate::conditional::{Posterior, PredictiveWorkspace};
 use crate::objective::ObjectiveError;
 use crate::params::{ModelConfig, Params};
+use crate::precision::Precision;
 
 /// Predictive moments over `T` steps.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -62,6 +63,15 @@ pub struct StepPredictor {
 }
 
 impl StepPredictor {
+    /// This predictor with its conditional's large products in `precision`
+    /// ([`Precision::Mixed`]: `[G; mᵀG] K` and `S(W⊙W)` in `f32`, see [`crate::precision`];
+    /// a variance that the `f32` rounding takes below zero counts as zero).
+    pub fn with_precision(mut self, precision: Precision) -> Self {
+        self.post.set_precision(precision);
+        self.ws = PredictiveWorkspace::new(&self.post, self.particles, self.particles);
+        self
+    }
+
     /// Prepares the conditional (factorizes `K_mm`) and buffers for `particles` particles.
     ///
     /// # Errors
@@ -112,6 +122,11 @@ impl StepPredictor {
         }
         self.ws.forward(&self.post, self.particles);
         let (vx, jit) = (&self.process_noise_var, self.jitter);
+        // Only the f32 products can take σ² below zero by more than σ_x² + δ covers.
+        let floor = match self.post.precision() {
+            Precision::F64 => f64::NEG_INFINITY,
+            Precision::Mixed => 0.0,
+        };
         for (c, ((x, var), e)) in x
             .chunks_exact_mut(dx)
             .zip(self.ws.var.chunks_exact(dx))
@@ -121,7 +136,7 @@ impl StepPredictor {
         {
             let mean = self.ws.mean(&self.post, c);
             for dd in 0..dx {
-                x[dd] += mean[dd] + (var[dd] + vx[dd] + jit).sqrt() * e[dd];
+                x[dd] += mean[dd] + (var[dd].max(floor) + vx[dd] + jit).sqrt() * e[dd];
             }
         }
     }
@@ -294,7 +309,32 @@ pub fn predict(
     seed: u64,
 ) -> Result<Prediction, ObjectiveError> {
     let init = (init_mean, init_std);
-    run_prediction(config, params, inputs, init, particles, seed, None)
+    let run = (particles, seed, Precision::F64);
+    run_prediction(config, params, inputs, init, run, None)
+}
+
+/// [`predict`] with the conditional's large products in `precision`
+/// ([`StepPredictor::with_precision`]); `Precision::F64` is [`predict`].
+///
+/// # Errors
+/// As [`predict`].
+pub fn predict_with_precision(
+    config: &ModelConfig,
+    params: &Params,
+    inputs: &[f64],
+    init: (&[f64], &[f64]),
+    particles: usize,
+    seed: u64,
+    precision: Precision,
+) -> Result<Prediction, ObjectiveError> {
+    run_prediction(
+        config,
+        params,
+        inputs,
+        init,
+        (particles, seed, precision),
+        None,
+    )
 }
 
 /// [`predict`] that also returns every particle, `T × P × D_x` row-major (standardized latent
@@ -313,27 +353,19 @@ pub fn predict_particles(
     let t_n = inputs.len().checked_div(config.n_input).unwrap_or(1).max(1);
     let mut all = vec![0.0; t_n * particles * config.n_state];
     let init = (init_mean, init_std);
-    let p = run_prediction(
-        config,
-        params,
-        inputs,
-        init,
-        particles,
-        seed,
-        Some(&mut all),
-    )?;
+    let run = (particles, seed, Precision::F64);
+    let p = run_prediction(config, params, inputs, init, run, Some(&mut all))?;
     Ok((p, all))
 }
 
-/// The prediction loop of [`predict`], copying the particles of every step into `keep`
-/// (`T × P × D_x`) when given.
+/// The prediction loop of [`predict`] with `(particles, seed, precision)`, copying the
+/// particles of every step into `keep` (`T × P × D_x`) when given.
 fn run_prediction(
     config: &ModelConfig,
     params: &Params,
     inputs: &[f64],
     (init_mean, init_std): (&[f64], &[f64]),
-    particles: usize,
-    seed: u64,
+    (particles, seed, precision): (usize, u64, Precision),
     mut keep: Option<&mut [f64]>,
 ) -> Result<Prediction, ObjectiveError> {
     let (dx, du, dy) = (config.n_state, config.n_input, config.n_output);
@@ -349,7 +381,7 @@ fn run_prediction(
         )));
     }
     let t_n = inputs.len().checked_div(du).unwrap_or(1);
-    let mut sp = StepPredictor::new(config, params, particles)?;
+    let mut sp = StepPredictor::new(config, params, particles)?.with_precision(precision);
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let mut x = vec![0.0; particles * dx];
     for c in x.chunks_exact_mut(dx) {

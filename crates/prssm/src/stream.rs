@@ -34,6 +34,7 @@ use rand_distr::{Distribution, StandardNormal};
 
 use crate::model::{Normalization, PrssmModel};
 use crate::objective::ObjectiveError;
+use crate::precision::Precision;
 use crate::predict::StepPredictor;
 
 /// A particle predictor advanced one input sample at a time (see the module docs).
@@ -101,6 +102,13 @@ impl StreamPredictor {
         let step = StepPredictor::new(&model.config, &model.params, 1)?;
         let init = (init_mean.to_vec(), vec![0.0; dx]);
         Ok(Self::assemble(model, step, 1, 0, init, true))
+    }
+
+    /// This predictor with its conditional's large products in `precision`
+    /// ([`StepPredictor::with_precision`]); the draws are unchanged.
+    pub fn with_precision(mut self, precision: Precision) -> Self {
+        self.step = self.step.with_precision(precision);
+        self
     }
 
     fn assemble(

@@ -120,8 +120,12 @@ fn a_streaming_step_does_not_allocate() {
     let u = inputs(50, 7);
     let mut stream = StreamPredictor::new(&model, 30, &[0.0; 12], &[0.0; 12], 1).unwrap();
     let mut mean_stream = StreamPredictor::mean_propagated(&model, &[0.0; 12]).unwrap();
+    let mut mixed = StreamPredictor::new(&model, 30, &[0.0; 12], &[0.0; 12], 1)
+        .unwrap()
+        .with_precision(flapssm_prssm::Precision::Mixed);
     stream.step(&u[..7]).unwrap();
     mean_stream.step(&u[..7]).unwrap();
+    mixed.step(&u[..7]).unwrap();
     let before = allocations();
     let mut acc = 0.0;
     for t in 1..50 {
@@ -129,12 +133,15 @@ fn a_streaming_step_does_not_allocate() {
         acc += m[0] + v[0];
         let (m, _) = mean_stream.step(&u[t * 7..(t + 1) * 7]).unwrap();
         acc += m[0];
+        let (m, v) = mixed.step(&u[t * 7..(t + 1) * 7]).unwrap();
+        acc += m[0] + v[0];
     }
     stream.reset();
     mean_stream.reset();
+    mixed.reset();
     let after = allocations();
     assert!(acc.is_finite());
-    assert_eq!(after - before, 0, "allocations during 98 streaming steps");
+    assert_eq!(after - before, 0, "allocations during 147 streaming steps");
 }
 
 #[test]

@@ -13,6 +13,7 @@ use flapssm_jobs::curve::{
 };
 use flapssm_prssm::Precision;
 use flapssm_prssm::train::bench::REFERENCE_SOLVE_S;
+use flapssm_prssm::train::fit::DEFAULT_WINDOWS_PER_TASK;
 
 /// Measure training, prediction and streaming speed (release build, this machine).
 #[derive(Args)]
@@ -39,10 +40,14 @@ pub struct BenchArgs {
     /// validation RMSE) would have ended the --train run, and what it would have kept.
     #[arg(long, value_name = "N", requires = "train", value_parser = super::positive::<usize>)]
     patience: Option<usize>,
-    /// Arithmetic of the timed training products: f64 (the reference) or mixed (the large
-    /// products in f32; docs/training.md).
+    /// Arithmetic of the timed training, prediction and streaming products: f64 (the
+    /// reference) or mixed (the large products in f32; docs/training.md).
     #[arg(long, default_value = "f64")]
     precision: Precision,
+    /// Windows (sequences) per parallel task of the timed minibatches: a minibatch of 16 keeps
+    /// at most ceil(16 / N) threads busy.
+    #[arg(long, value_name = "N", default_value_t = DEFAULT_WINDOWS_PER_TASK, value_parser = super::positive::<usize>)]
+    windows_per_task: usize,
 }
 
 /// Prints the time-to-quality of `run` against `reference`.
@@ -119,6 +124,7 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
         reps: args.reps,
         seed: args.seed,
         precision: args.precision,
+        windows_per_task: args.windows_per_task,
     })
     .context("flapssm bench")?;
     let threads = r.threads;
@@ -134,8 +140,9 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
         speed_against_reference_machine(&r)
     );
     println!(
-        "training epoch (512 seq x 470 steps x 30 particles, batch 16, {threads} threads, {} precision): \
+        "training epoch (512 seq x 470 steps x 30 particles, batch 16, {threads} threads, {} windows per task, {} precision): \
          {:.3} s ({} batches timed), {:.1}x faster than the authors' {AUTHORS_EPOCH_S} s",
+        r.windows_per_task,
         r.precision,
         r.epoch_s,
         r.batches,
@@ -152,15 +159,17 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
         r.fastest_epoch_s
     );
     println!(
-        "prediction (470 steps x 30 particles, 1 thread): {:.3} ms, {:.1} GFLOP/s ({:.0} % of the GEMM rate), \
+        "prediction (470 steps x 30 particles, 1 thread, {} precision): {:.3} ms, {:.1} GFLOP/s ({:.0} % of the f64 GEMM rate), \
          {:.1}x faster than the authors' {AUTHORS_PREDICT_S} s",
+        r.precision,
         r.predict_s * 1e3,
         r.predict_gflops,
         100.0 * r.predict_gflops / r.gemm_gflops,
         AUTHORS_PREDICT_S / r.predict_s
     );
     println!(
-        "streaming step (30 particles): {:.1} us, {:.1} GFLOP/s",
+        "streaming step (30 particles, {} precision): {:.1} us, {:.1} GFLOP/s",
+        r.precision,
         r.stream_step_s * 1e6,
         r.stream_gflops
     );

@@ -40,7 +40,9 @@ pub use workspace::{ConditionalGrads, ConditionalWorkspace, tape_len};
 use faer::{Accum, MatRef};
 
 use crate::kernel::{self, KernelKind};
-use crate::linalg::{cholesky_backward, cholesky_in_place, gemm, lower_inverse, view, view_mut};
+use crate::linalg::{
+    cholesky_backward, cholesky_in_place, f32_operand, gemm, lower_inverse, view, view_mut,
+};
 use crate::objective::ObjectiveError;
 use crate::params::{CovarianceStructure, ModelConfig, Parametrization, Params};
 use crate::precision::Precision;
@@ -178,7 +180,7 @@ impl Posterior {
     /// Sets the precision of the large products of the workspaces that use this cache
     /// ([`Precision::Mixed`] rounds `[G; mᵀG]` to `f32` here, once).
     pub fn set_precision(&mut self, precision: Precision) {
-        let round = |v: &[f64]| v.iter().map(|&x| x as f32).collect();
+        let round = |v: &[f64]| v.iter().map(|&x| f32_operand(x)).collect();
         let mixed = precision == Precision::Mixed;
         self.g_mean32 = if mixed {
             round(&self.g_mean)

@@ -4,11 +4,14 @@ use faer::Accum;
 
 use super::Posterior;
 use crate::kernel;
-use crate::linalg::{dot, gemm, view, view_mut, widen_into};
+use crate::linalg::{dot, f32_operand, gemm, round_into, view, view_mut, widen_into};
 use crate::params::CovarianceStructure;
+use crate::precision::Precision;
 
 /// Forward-only conditional for prediction (no derivatives, no tape). `W` and the means come
 /// from one product `[W; μ] = [G; mᵀG] K` (`(M + D_x) × N`); `σ²` as in [`ConditionalWorkspace`].
+/// Under a [`Precision::Mixed`] posterior the product and `S(W⊙W)` run in `f32`, as in training
+/// ([`crate::precision`]); the kernel and the cancellation `σ_f² − Σ H⊙W` stay `f64`.
 #[derive(Debug, Clone)]
 pub(crate) struct PredictiveWorkspace {
     cap: usize,
@@ -23,6 +26,9 @@ pub(crate) struct PredictiveWorkspace {
     tau_shared: Vec<f64>,
     /// Variances `σ²`, column-major `D_x × N`.
     pub var: Vec<f64>,
+    /// `f32` operands and results under [`Precision::Mixed`]: `K` (`M × N`), `[W; μ]`
+    /// (`(M + D_x) × N`), `W⊙W` (`M × N`), `S(W⊙W)` (`D_x × N`).
+    mixed: Option<[Vec<f32>; 4]>,
 }
 
 impl PredictiveWorkspace {
@@ -40,6 +46,14 @@ impl PredictiveWorkspace {
             w2: vec![0.0; m * n],
             tau_shared: vec![0.0; m],
             var: vec![0.0; dx * n],
+            mixed: (post.precision() == Precision::Mixed).then(|| {
+                [
+                    vec![0.0; m * n],
+                    vec![0.0; (m + dx) * n],
+                    vec![0.0; m * n],
+                    vec![0.0; dx * n],
+                ]
+            }),
         }
     }
 
@@ -67,20 +81,37 @@ impl PredictiveWorkspace {
             &mut self.k[..m * n],
             &mut self.tau_shared,
         );
-        gemm(
-            view_mut(&mut self.wm, r, n),
-            Accum::Replace,
-            post.g_mean(),
-            view(&self.k, m, n),
-            1.0,
-        );
+        let mixed = match self.mixed.as_mut() {
+            None => {
+                gemm(
+                    view_mut(&mut self.wm, r, n),
+                    Accum::Replace,
+                    post.g_mean(),
+                    view(&self.k, m, n),
+                    1.0,
+                );
+                None
+            }
+            Some([k32, wm32, w2_32, var32]) => {
+                round_into(&self.k[..m * n], k32);
+                gemm(
+                    view_mut(wm32, r, n),
+                    Accum::Replace,
+                    post.g_mean32(),
+                    view(k32, m, n),
+                    1.0,
+                );
+                widen_into(&wm32[..r * n], &mut self.wm, Accum::Replace);
+                Some((&mut w2_32[..], &mut var32[..]))
+            }
+        };
         let k = if post.whitened {
             None
         } else {
             Some(&self.k[..])
         };
         let (w2, var) = (&mut self.w2, &mut self.var);
-        write_predictive_variance(post, &self.wm, r, k, n, w2, var, None, None);
+        write_predictive_variance(post, &self.wm, r, k, n, w2, var, None, mixed);
     }
 }
 
@@ -110,8 +141,7 @@ pub(super) fn write_predictive_variance(
         (CovarianceStructure::Diagonal, Some((w2_32, var32))) if !post.q_cov32.is_empty() => {
             for (c2, wc) in w2_32[..m * n].chunks_exact_mut(m).zip(w.chunks(stride)) {
                 c2.iter_mut().zip(&wc[..m]).for_each(|(a, &b)| {
-                    let b = b as f32;
-                    *a = b * b;
+                    *a = f32_operand(b * b);
                 });
             }
             gemm(

@@ -6,7 +6,7 @@ use faer::Accum;
 use super::Posterior;
 use super::predictive::write_predictive_variance;
 use crate::kernel;
-use crate::linalg::{dot, gemm, round_into, view, view_mut, widen_into};
+use crate::linalg::{dot, f32_operand, gemm, round_into, view, view_mut, widen_into};
 use crate::params::CovarianceStructure;
 use crate::precision::Precision;
 
@@ -326,8 +326,7 @@ impl ConditionalWorkspace {
                     let (pc, wc) = (&mut pc[..m], &wc[..m]);
                     let s = -2.0 * bb;
                     for (((w2, p), &v), &wv) in w2.iter_mut().zip(pc.iter_mut()).zip(vc).zip(wc) {
-                        let w32 = wv as f32;
-                        *w2 = w32 * w32;
+                        *w2 = f32_operand(wv * wv);
                         *p = 2.0 * wv * f64::from(v);
                         if whitened {
                             *p += s * wv;

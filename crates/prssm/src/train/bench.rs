@@ -13,6 +13,7 @@ use super::fit::FitSpec;
 use crate::elbo::{Elbo, ElboError, ElboOptions, Sequence, TrainingData};
 use crate::model::PrssmModel;
 use crate::params::{ModelConfig, Params};
+use crate::precision::Precision;
 use crate::predict;
 use crate::stream::StreamPredictor;
 use crate::systems::random_input;
@@ -169,6 +170,7 @@ pub fn synthetic_objective(
     let options = ElboOptions {
         particles: spec.particles,
         burn_in_fraction: spec.burn_in_fraction,
+        windows_per_task: spec.windows_per_task,
         ..ElboOptions::paper(n_sequences)
     };
     let elbo = Elbo::new(spec.model.clone(), data, options)?;
@@ -249,6 +251,7 @@ pub fn time_prediction(
     len: usize,
     particles: usize,
     reps: usize,
+    precision: Precision,
 ) -> Result<f64, ObjectiveError> {
     let (du, dy) = (model.config.n_input, model.config.n_output);
     let seq = &synthetic_sequences(1, len, du, dy, 5)[0];
@@ -256,14 +259,14 @@ pub fn time_prediction(
     let mut times = Vec::with_capacity(reps);
     for r in 0..reps.max(1) {
         let t0 = Instant::now();
-        let p = predict::predict(
+        let p = predict::predict_with_precision(
             &model.config,
             &model.params,
             &seq.inputs,
-            &zero,
-            &zero,
+            (&zero, &zero),
             particles,
             r as u64,
+            precision,
         )?;
         times.push(t0.elapsed().as_secs_f64());
         std::hint::black_box(p);
@@ -280,11 +283,12 @@ pub fn time_stream_step(
     model: &PrssmModel,
     particles: usize,
     steps: usize,
+    precision: Precision,
 ) -> Result<f64, ObjectiveError> {
     let (du, dy) = (model.config.n_input, model.config.n_output);
     let seq = &synthetic_sequences(1, steps.max(1), du, dy, 6)[0];
     let zero = vec![0.0; model.config.n_state];
-    let mut s = StreamPredictor::new(model, particles, &zero, &zero, 1)?;
+    let mut s = StreamPredictor::new(model, particles, &zero, &zero, 1)?.with_precision(precision);
     let du = model.config.n_input;
     s.step(&seq.inputs[..du])?;
     let t0 = Instant::now();
