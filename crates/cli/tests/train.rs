@@ -430,6 +430,38 @@ fn the_task_size_is_recorded_and_changes_only_rounding() {
     assert!(err.contains("--windows-per-task"), "{err}");
 }
 
+/// `--lengthscale-init L` starts every lengthscale at L: recorded in the model's spec, visible
+/// in the parameters after a step of a vanishing learning rate; a non-positive value is
+/// refused naming the setting.
+#[test]
+fn the_initial_lengthscale_is_selectable() {
+    let dir = tempfile::tempdir().unwrap();
+    let data = simulated(dir.path(), 2, 3);
+    let out = dir.path().join("l.json");
+    let mut args = train_args(&data, &out, "1");
+    args.extend([
+        "--lengthscale-init",
+        "7.5",
+        "--lr",
+        "1e-9",
+        "--val-fraction",
+        "0",
+    ]);
+    ok(&args);
+    let model = json(&out)["model"].clone();
+    assert_eq!(model["training"]["spec"]["init"]["lengthscale"], 7.5);
+    for l in model["params"]["lengthscales"].as_array().unwrap() {
+        assert!((l.as_f64().unwrap() - 7.5).abs() < 1e-6, "{l}");
+    }
+    let bad = dir.path().join("bad.json");
+    let mut args = train_args(&data, &bad, "1");
+    args.extend(["--lengthscale-init", "0"]);
+    let o = flapssm(&args);
+    assert!(!o.status.success());
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("lengthscale_init"), "{err}");
+}
+
 /// `--patience N` ends the run once N evaluated epochs in a row bring no new best model, and
 /// says so; the model files are written as for a whole run.
 #[test]

@@ -64,6 +64,9 @@ pub struct TrainingOptions {
     /// windows keeps at most `⌈B / n⌉` threads busy.
     #[serde(default)]
     pub windows_per_task: Option<usize>,
+    /// Initial lengthscale of every GP input, standardized units (the preset's 2 when `None`).
+    #[serde(default)]
+    pub lengthscale_init: Option<f64>,
     /// Checkpoint every this many epochs (0: only when interrupted).
     pub checkpoint_every: u64,
 }
@@ -90,6 +93,7 @@ impl Default for TrainingOptions {
             patience: None,
             precision: Precision::F64,
             windows_per_task: None,
+            lengthscale_init: None,
             checkpoint_every: 10,
         }
     }
@@ -136,6 +140,9 @@ impl TrainingOptions {
         spec.precision = self.precision;
         if let Some(v) = self.windows_per_task {
             spec.windows_per_task = v;
+        }
+        if let Some(v) = self.lengthscale_init {
+            spec.init.lengthscale = v;
         }
         spec.train.seed = self.seed;
         spec.train.checkpoint_every = self.checkpoint_every;
@@ -188,6 +195,15 @@ impl TrainingOptions {
             && !(lr > 0.0 && lr.is_finite())
         {
             return bad("lr", lr.to_string(), "must be positive and finite");
+        }
+        if let Some(l) = self.lengthscale_init
+            && !(l > 0.0 && l.is_finite())
+        {
+            return bad(
+                "lengthscale_init",
+                l.to_string(),
+                "must be positive and finite",
+            );
         }
         let spec = self.spec();
         let m = &spec.model;

@@ -219,7 +219,7 @@ impl Stream {
     epochs=None, iterations=None, batch=None, lr=None, seed=0, val_fraction=0.1,
     checkpoint_every=10, resume=false, progress=None, best_by="rmse",
     objective="standard", inducing_init=None, patience=None, precision="f64",
-    windows_per_task=None))]
+    windows_per_task=None, lengthscale_init=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn train(
     py: Python<'_>,
@@ -244,6 +244,7 @@ pub fn train(
     patience: Option<u64>,
     precision: &str,
     windows_per_task: Option<usize>,
+    lengthscale_init: Option<f64>,
 ) -> PyResult<Prssm> {
     let best_by: flapssm_prssm::train::BestBy = best_by
         .parse()
@@ -279,6 +280,7 @@ pub fn train(
         patience,
         precision,
         windows_per_task,
+        lengthscale_init,
         checkpoint_every,
     }
     .check()

@@ -102,6 +102,10 @@ def test_bad_input_raises_the_right_exception(small, tmp_path):
         flapssm.train(small, tmp_path / "m.json", inducing_init="grid")
     with pytest.raises(ValueError, match="precision"):
         flapssm.train(small, tmp_path / "m.json", precision="f16")
+    with pytest.raises(ValueError, match="lengthscale_init"):
+        flapssm.train(small, tmp_path / "m.json", lengthscale_init=-1.0)
+    with pytest.raises(ValueError, match="windows_per_task"):
+        flapssm.train(small, tmp_path / "m.json", windows_per_task=0)
     with pytest.raises(OSError, match="is a directory"):
         small.save(tmp_path)
 
@@ -134,10 +138,12 @@ def test_keyboard_interrupt_leaves_a_resumable_checkpoint(small, tmp_path):
     assert [int(r.split(",")[0]) for r in rows[2:]] == list(range(6))
 
 
-def test_kmeans_start_and_precision_are_recorded(small, tmp_path):
-    model = _tiny(small, tmp_path / "k.json", inducing_init="kmeans", precision="mixed")
+def test_start_precision_and_task_size_are_recorded(small, tmp_path):
+    model = _tiny(small, tmp_path / "k.json", inducing_init="kmeans", precision="mixed",
+                  windows_per_task=1, lengthscale_init=5.0)
     spec = json.loads(model.to_json())["training"]["spec"]
     assert spec["inducing_init"] == "kmeans" and spec["precision"] == "mixed"
+    assert spec["windows_per_task"] == 1 and spec["init"]["lengthscale"] == 5.0
 
 
 def test_ctrl_c_from_outside_stops_training_with_a_checkpoint(small, tmp_path):

@@ -73,6 +73,10 @@ pub struct DemoArgs {
     /// thread count not at all, on N only in the last bits (docs/training.md).
     #[arg(long, value_name = "N", value_parser = super::positive::<usize>)]
     windows_per_task: Option<usize>,
+    /// Override the initial lengthscale of every GP input, in standardized units (published:
+    /// 2; docs/training.md, "Time to quality").
+    #[arg(long, value_name = "L")]
+    lengthscale_init: Option<f64>,
     /// Override where the trajectories come from: generator (the default) or paper (the
     /// paper's measured trajectories, the default with --full; the first --trajectories).
     #[arg(long, value_enum, value_name = "SOURCE")]
@@ -133,6 +137,9 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
     }
     if args.windows_per_task.is_some() {
         cfg.training.windows_per_task = args.windows_per_task;
+    }
+    if args.lengthscale_init.is_some() {
+        cfg.training.lengthscale_init = args.lengthscale_init;
     }
     let stop = stop_flag()?;
     let bars = Bars::new();

@@ -135,6 +135,7 @@ fn run_one(a: RunArgs) -> anyhow::Result<()> {
         patience: a.patience,
         precision: a.precision,
         windows_per_task: a.windows_per_task,
+        lengthscale_init: None,
         checkpoint_every: 0,
     };
     let plan = SweepSettings {

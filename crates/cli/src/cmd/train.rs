@@ -81,6 +81,10 @@ pub struct TrainArgs {
     /// thread count not at all, on N only in the last bits (docs/training.md).
     #[arg(long, value_name = "N", value_parser = super::positive::<usize>)]
     windows_per_task: Option<usize>,
+    /// Initial lengthscale of every GP input, in standardized units (default: the preset's,
+    /// 2 as published).
+    #[arg(long, value_name = "L")]
+    lengthscale_init: Option<f64>,
     /// Write a checkpoint every N epochs (0: only on Ctrl-C).
     #[arg(long, default_value_t = 10)]
     checkpoint_every: u64,
@@ -139,6 +143,7 @@ pub fn run(args: TrainArgs) -> anyhow::Result<()> {
         patience: args.patience,
         precision: args.precision,
         windows_per_task: args.windows_per_task,
+        lengthscale_init: args.lengthscale_init,
         checkpoint_every: args.checkpoint_every,
     }
     .check()?;

@@ -174,6 +174,7 @@ def train(
     patience: Optional[int] = None,
     precision: str = "f64",
     windows_per_task: Optional[int] = None,
+    lengthscale_init: Optional[float] = None,
 ) -> "_native.Prssm":
     """Trains a PR-SSM (``flapssm train``) on the dataset's training trajectories; writes
     the best model to ``out``, the last to ``<out>.last.json``, checkpoints to
@@ -188,12 +189,14 @@ def train(
     epochs in a row bring no new best model. ``precision``: ``"f64"`` (the reference) or
     ``"mixed"`` (the ELBO's large products in f32). ``windows_per_task``: sequences per
     parallel task (default 4; a minibatch of ``batch`` keeps at most ``batch / n`` threads
-    busy; results change only in the last bits)."""
+    busy; results change only in the last bits). ``lengthscale_init``: the initial
+    lengthscale of every GP input in standardized units (default: the preset's 2)."""
     return _native.train(
         dataset, os.fspath(out), preset, dx, inducing, particles, epochs, iterations, batch,
         lr, int(seed), float(val_fraction), int(checkpoint_every), bool(resume), progress,
         best_by, objective, inducing_init, None if patience is None else int(patience),
         precision, None if windows_per_task is None else int(windows_per_task),
+        None if lengthscale_init is None else float(lengthscale_init),
     )
 
 
