@@ -462,6 +462,29 @@ fn the_initial_lengthscale_is_selectable() {
     assert!(err.contains("lengthscale_init"), "{err}");
 }
 
+/// `--preset paper-fast` trains with its own precision, task size and initial lengthscale
+/// unless a flag overrides them (`--precision f64`).
+#[test]
+fn the_fast_preset_brings_its_settings_and_flags_override_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let data = simulated(dir.path(), 2, 3);
+    let spec_of = |name: &str, extra: &[&str]| {
+        let out = dir.path().join(format!("{name}.json"));
+        let mut args = train_args(&data, &out, "1");
+        args.extend(["--preset", "paper-fast", "--val-fraction", "0"]);
+        args.extend(extra);
+        ok(&args);
+        json(&out)["model"]["training"]["spec"].clone()
+    };
+    let fast = spec_of("fast", &[]);
+    assert_eq!(fast["precision"], "mixed");
+    assert_eq!(fast["windows_per_task"], 2);
+    assert_eq!(fast["init"]["lengthscale"], 10.0);
+    let f64_spec = spec_of("fast64", &["--precision", "f64"]);
+    assert_eq!(f64_spec["precision"], "f64");
+    assert_eq!(f64_spec["init"]["lengthscale"], 10.0);
+}
+
 /// `--patience N` ends the run once N evaluated epochs in a row bring no new best model, and
 /// says so; the model files are written as for a whole run.
 #[test]

@@ -20,7 +20,8 @@ use crate::progress::Progress;
 /// PR-SSM training settings shared by the sweeps and the demo: a preset with overrides.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct TrainingOptions {
-    /// Named preset (paper: D_x 12, M 100, 30 particles, batch 16, lr 0.03, 1000 epochs).
+    /// Named preset (paper: D_x 12, M 100, 30 particles, batch 16, lr 0.03, 1000 epochs;
+    /// paper-fast; sysid).
     pub preset: Preset,
     /// Latent dimension D_x.
     pub dx: Option<usize>,
@@ -57,9 +58,10 @@ pub struct TrainingOptions {
     /// Early stopping: end when this many evaluated epochs in a row bring no new best model.
     #[serde(default)]
     pub patience: Option<u64>,
-    /// Arithmetic of the ELBO's large products (f64, the reference, or mixed).
+    /// Arithmetic of the ELBO's large products (f64, the reference, or mixed; the preset's
+    /// when `None`).
     #[serde(default)]
-    pub precision: Precision,
+    pub precision: Option<Precision>,
     /// Windows per parallel task of the ELBO (the preset's 4 when `None`): a minibatch of `B`
     /// windows keeps at most `⌈B / n⌉` threads busy.
     #[serde(default)]
@@ -91,7 +93,7 @@ impl Default for TrainingOptions {
             objective: ObjectiveForm::Standard,
             inducing_init: None,
             patience: None,
-            precision: Precision::F64,
+            precision: None,
             windows_per_task: None,
             lengthscale_init: None,
             checkpoint_every: 10,
@@ -137,7 +139,9 @@ impl TrainingOptions {
         if self.patience.is_some() {
             spec.train.patience = self.patience;
         }
-        spec.precision = self.precision;
+        if let Some(p) = self.precision {
+            spec.precision = p;
+        }
         if let Some(v) = self.windows_per_task {
             spec.windows_per_task = v;
         }

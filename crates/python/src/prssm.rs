@@ -218,7 +218,7 @@ impl Stream {
 #[pyo3(signature = (dataset, out, preset="paper", dx=None, inducing=None, particles=None,
     epochs=None, iterations=None, batch=None, lr=None, seed=0, val_fraction=0.1,
     checkpoint_every=10, resume=false, progress=None, best_by="rmse",
-    objective="standard", inducing_init=None, patience=None, precision="f64",
+    objective="standard", inducing_init=None, patience=None, precision=None,
     windows_per_task=None, lengthscale_init=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn train(
@@ -242,7 +242,7 @@ pub fn train(
     objective: &str,
     inducing_init: Option<&str>,
     patience: Option<u64>,
-    precision: &str,
+    precision: Option<&str>,
     windows_per_task: Option<usize>,
     lengthscale_init: Option<f64>,
 ) -> PyResult<Prssm> {
@@ -256,8 +256,9 @@ pub fn train(
         .map(str::parse)
         .transpose()
         .map_err(|e: String| PyValueError::new_err(format!("inducing_init: {e}")))?;
-    let precision: flapssm_prssm::Precision = precision
-        .parse()
+    let precision: Option<flapssm_prssm::Precision> = precision
+        .map(str::parse)
+        .transpose()
         .map_err(|e: String| PyValueError::new_err(format!("precision: {e}")))?;
     let plan = TrainingOptions {
         preset: preset

@@ -132,8 +132,8 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
     if args.patience.is_some() {
         cfg.training.patience = args.patience;
     }
-    if let Some(p) = args.precision {
-        cfg.training.precision = p;
+    if args.precision.is_some() {
+        cfg.training.precision = args.precision;
     }
     if args.windows_per_task.is_some() {
         cfg.training.windows_per_task = args.windows_per_task;

@@ -40,7 +40,7 @@ pub struct RunArgs {
     /// Result file (.json).
     #[arg(long)]
     out: PathBuf,
-    /// Training preset (paper or sysid).
+    /// Training preset: paper, paper-fast or sysid.
     #[arg(long, default_value = "paper")]
     preset: Preset,
     /// Latent dimension D_x (ignored for --kind dx).
@@ -77,9 +77,10 @@ pub struct RunArgs {
     #[arg(long, value_name = "N", value_parser = super::positive::<u64>)]
     patience: Option<u64>,
     /// Arithmetic of the ELBO's large products: f64 (the reference) or mixed (those products
-    /// in f32, everything else in f64; docs/training.md).
-    #[arg(long, default_value = "f64")]
-    precision: Precision,
+    /// in f32, everything else in f64; docs/training.md). Default: the preset's (f64, and
+    /// mixed for paper-fast).
+    #[arg(long)]
+    precision: Option<Precision>,
     /// Windows (sequences) per parallel task of the ELBO: a minibatch of B windows keeps at
     /// most ceil(B / N) threads busy (default 4: batch 16 fills 4 cores); results depend on the
     /// thread count not at all, on N only in the last bits (docs/training.md).

@@ -23,7 +23,9 @@ pub struct TrainArgs {
     /// `<out stem>.last.json`.
     #[arg(long)]
     out: PathBuf,
-    /// Named preset: paper (Bayiz & Cheng 2021) or sysid (Doerr et al. 2018).
+    /// Named preset: paper (Bayiz & Cheng 2021), paper-fast (the paper's model trained for
+    /// time to quality: initial lengthscales 10, batch 4, 10 particles, mixed precision, 100
+    /// epochs; docs/training.md) or sysid (Doerr et al. 2018).
     #[arg(long, default_value = "paper")]
     preset: Preset,
     /// Latent dimension D_x.
@@ -73,9 +75,10 @@ pub struct TrainArgs {
     #[arg(long, value_name = "N", value_parser = super::positive::<u64>)]
     patience: Option<u64>,
     /// Arithmetic of the ELBO's large products: f64 (the reference) or mixed (those products
-    /// in f32, everything else in f64; docs/training.md).
-    #[arg(long, default_value = "f64")]
-    precision: Precision,
+    /// in f32, everything else in f64; docs/training.md). Default: the preset's (f64, and
+    /// mixed for paper-fast).
+    #[arg(long)]
+    precision: Option<Precision>,
     /// Windows (sequences) per parallel task of the ELBO: a minibatch of B windows keeps at
     /// most ceil(B / N) threads busy (default 4: batch 16 fills 4 cores); results depend on the
     /// thread count not at all, on N only in the last bits (docs/training.md).

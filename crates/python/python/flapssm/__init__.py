@@ -172,7 +172,7 @@ def train(
     objective: str = "standard",
     inducing_init: Optional[str] = None,
     patience: Optional[int] = None,
-    precision: str = "f64",
+    precision: Optional[str] = None,
     windows_per_task: Optional[int] = None,
     lengthscale_init: Optional[float] = None,
 ) -> "_native.Prssm":
@@ -187,10 +187,12 @@ def train(
     shared noise draws, to re-run their exact training). ``inducing_init``: ``"uniform"``
     or ``"kmeans"`` (default: the preset's). ``patience``: end when that many evaluated
     epochs in a row bring no new best model. ``precision``: ``"f64"`` (the reference) or
-    ``"mixed"`` (the ELBO's large products in f32). ``windows_per_task``: sequences per
-    parallel task (default 4; a minibatch of ``batch`` keeps at most ``batch / n`` threads
-    busy; results change only in the last bits). ``lengthscale_init``: the initial
-    lengthscale of every GP input in standardized units (default: the preset's 2)."""
+    ``"mixed"`` (the ELBO's large products in f32; default: the preset's). ``windows_per_task``:
+    sequences per parallel task (default: the preset's; a minibatch of ``batch`` keeps at most
+    ``batch / n`` threads busy; results change only in the last bits). ``lengthscale_init``:
+    the initial lengthscale of every GP input in standardized units (default: the preset's).
+    Presets: ``"paper"`` (the published run), ``"paper-fast"`` (the paper's model trained for
+    time to quality), ``"sysid"`` (Doerr et al.)."""
     return _native.train(
         dataset, os.fspath(out), preset, dx, inducing, particles, epochs, iterations, batch,
         lr, int(seed), float(val_fraction), int(checkpoint_every), bool(resume), progress,

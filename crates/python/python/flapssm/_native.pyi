@@ -105,7 +105,7 @@ def train(dataset: Dataset, out: _Path, preset: str = "paper", dx: Optional[int]
           seed: int = 0, val_fraction: float = 0.1, checkpoint_every: int = 10, resume: bool = False,
           progress: _Progress = None, best_by: str = "rmse",
           objective: str = "standard", inducing_init: Optional[str] = None,
-          patience: Optional[int] = None, precision: str = "f64",
+          patience: Optional[int] = None, precision: Optional[str] = None,
           windows_per_task: Optional[int] = None,
           lengthscale_init: Optional[float] = None) -> Prssm: ...
 def evaluate(dataset: Dataset, out: _Path, prssm: Optional[Prssm] = None, lrqsm: Optional[Lrqsm] = None,
