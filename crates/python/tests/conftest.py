@@ -2,6 +2,7 @@
 README's test command builds it before pytest runs) and ../shared/reference."""
 
 import pathlib
+import signal
 import subprocess
 
 import pytest
@@ -24,3 +25,14 @@ def cli():
 @pytest.fixture(scope="session")
 def published():
     return SHARED / "reference" / "bayiz2021-prssm" / "reference.npz"
+
+
+@pytest.fixture
+def sigint_raises():
+    """SIGINT raises KeyboardInterrupt during the test, whatever the process inherited: a job
+    that a non-interactive shell starts in the background (`cmd &`, `nohup cmd &`) ignores
+    SIGINT, Python keeps that disposition, and a test that sends SIGINT would then wait for
+    a training that never stops."""
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    yield
+    signal.signal(signal.SIGINT, previous)

@@ -115,7 +115,7 @@ def _tiny(small, out, **kw):
                          checkpoint_every=0, seed=2, **kw)
 
 
-def test_keyboard_interrupt_leaves_a_resumable_checkpoint(small, tmp_path):
+def test_keyboard_interrupt_leaves_a_resumable_checkpoint(small, tmp_path, sigint_raises):
     whole = _tiny(small, tmp_path / "whole.json")
     calls = []
 
@@ -146,7 +146,7 @@ def test_start_precision_and_task_size_are_recorded(small, tmp_path):
     assert spec["windows_per_task"] == 1 and spec["init"]["lengthscale"] == 5.0
 
 
-def test_ctrl_c_from_outside_stops_training_with_a_checkpoint(small, tmp_path):
+def test_ctrl_c_from_outside_stops_training_with_a_checkpoint(small, tmp_path, sigint_raises):
     # SIGINT from another thread while the main thread is inside the Rust training loop
     # (no callback): the loop's own check of Python's signals stops it.
     import threading
