@@ -334,51 +334,61 @@ fn the_inducing_start_is_selectable_and_recorded() {
     assert!(err.contains("kmeans") && err.contains("uniform"), "{err}");
 }
 
+/// Trains one epoch of `data` into `dir/<name>.json` with `flags` (and no validation split);
+/// returns the model's training spec and its first-epoch mean loss.
+fn one_epoch(dir: &Path, data: &Path, name: &str, flags: &[&str]) -> (serde_json::Value, f64) {
+    let out = dir.join(format!("{name}.json"));
+    let mut args = train_args(data, &out, "1");
+    args.extend(["--val-fraction", "0"]);
+    args.extend(flags);
+    ok(&args);
+    let training = json(&out)["model"]["training"].clone();
+    let loss = training["history"][0]["mean_loss"].as_f64().unwrap();
+    (training["spec"].clone(), loss)
+}
+
+/// Resuming the checkpoint of the `one_epoch` run `name` with `flags` is refused naming the
+/// run context, and writes nothing.
+fn resume_is_refused(dir: &Path, data: &Path, name: &str, flags: &[&str]) {
+    let ckpt = dir.join(format!("{name}.ckpt.json"));
+    let out = dir.join("resumed.json");
+    let mut args = train_args(data, &out, "2");
+    args.extend(["--val-fraction", "0", "--resume", "--checkpoint", s(&ckpt)]);
+    args.extend(flags);
+    assert_fails(&flapssm(&args), &["run_context.fit"], &out);
+}
+
+/// A bad flag value is a usage error (status 2) whose message contains every needle.
+fn usage_error(dir: &Path, data: &Path, flags: &[&str], needles: &[&str]) {
+    let out = dir.join("refused.json");
+    let mut args = train_args(data, &out, "1");
+    args.extend(flags);
+    let o = flapssm(&args);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(needles.iter().all(|n| err.contains(n)), "{err}");
+}
+
 /// `--precision mixed` trains with the large products in f32: recorded in the model file, a
 /// first-epoch loss within 1e-5 relative of f64's but not equal to it; a checkpoint of one
 /// precision is not resumed with the other; a bad value is refused naming the choices.
 #[test]
 fn the_precision_is_selectable_and_recorded() {
     let dir = tempfile::tempdir().unwrap();
-    let data = simulated(dir.path(), 2, 3);
-    let loss_of = |precision: &str| {
-        let out = dir.path().join(format!("{precision}.json"));
-        let mut args = train_args(&data, &out, "1");
-        args.extend(["--precision", precision, "--val-fraction", "0"]);
-        ok(&args);
-        let model = json(&out)["model"].clone();
-        assert_eq!(model["training"]["spec"]["precision"], precision);
-        model["training"]["history"][0]["mean_loss"]
-            .as_f64()
-            .unwrap()
-    };
-    let (f64_loss, mixed_loss) = (loss_of("f64"), loss_of("mixed"));
+    let (dir, data) = (dir.path(), simulated(dir.path(), 2, 3));
+    let (f64_spec, f64_loss) = one_epoch(dir, &data, "f64", &["--precision", "f64"]);
+    let (mixed_spec, mixed_loss) = one_epoch(dir, &data, "mixed", &["--precision", "mixed"]);
+    assert_eq!(
+        (&f64_spec["precision"], &mixed_spec["precision"]),
+        (&"f64".into(), &"mixed".into())
+    );
     let rel = (mixed_loss - f64_loss).abs() / f64_loss.abs();
     assert!(
         rel > 0.0 && rel < 1e-5,
         "f64 {f64_loss}, mixed {mixed_loss}"
     );
-
-    let ckpt = dir.path().join("f64.ckpt.json");
-    let out = dir.path().join("q.json");
-    let mut args = train_args(&data, &out, "2");
-    args.extend([
-        "--precision",
-        "mixed",
-        "--val-fraction",
-        "0",
-        "--resume",
-        "--checkpoint",
-    ]);
-    args.push(s(&ckpt));
-    assert_fails(&flapssm(&args), &["run_context.fit"], &out);
-
-    let mut args = train_args(&data, &out, "1");
-    args.extend(["--precision", "half"]);
-    let o = flapssm(&args);
-    assert_eq!(o.status.code(), Some(2));
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert!(err.contains("f64") && err.contains("mixed"), "{err}");
+    resume_is_refused(dir, &data, "f64", &["--precision", "mixed"]);
+    usage_error(dir, &data, &["--precision", "half"], &["f64", "mixed"]);
 }
 
 /// `--windows-per-task N` is recorded in the model file and changes the first-epoch loss only
@@ -387,47 +397,27 @@ fn the_precision_is_selectable_and_recorded() {
 #[test]
 fn the_task_size_is_recorded_and_changes_only_rounding() {
     let dir = tempfile::tempdir().unwrap();
-    let data = simulated(dir.path(), 2, 3);
-    let loss_of = |per_task: &str| {
-        let out = dir.path().join(format!("t{per_task}.json"));
-        let mut args = train_args(&data, &out, "1");
-        args.extend(["--windows-per-task", per_task, "--val-fraction", "0"]);
-        ok(&args);
-        let model = json(&out)["model"].clone();
-        assert_eq!(
-            model["training"]["spec"]["windows_per_task"].as_u64(),
-            per_task.parse().ok()
-        );
-        model["training"]["history"][0]["mean_loss"]
-            .as_f64()
-            .unwrap()
-    };
-    let (one, four) = (loss_of("1"), loss_of("4"));
+    let (dir, data) = (dir.path(), simulated(dir.path(), 2, 3));
+    let (one_spec, one) = one_epoch(dir, &data, "t1", &["--windows-per-task", "1"]);
+    let (four_spec, four) = one_epoch(dir, &data, "t4", &["--windows-per-task", "4"]);
+    assert_eq!(
+        (
+            &one_spec["windows_per_task"],
+            &four_spec["windows_per_task"]
+        ),
+        (&1.into(), &4.into())
+    );
     assert!(
         (one - four).abs() <= 1e-6 * four.abs(),
         "1 per task {one}, 4 per task {four}"
     );
-
-    let ckpt = dir.path().join("t1.ckpt.json");
-    let out = dir.path().join("r.json");
-    let mut args = train_args(&data, &out, "2");
-    args.extend([
-        "--windows-per-task",
-        "4",
-        "--val-fraction",
-        "0",
-        "--resume",
-        "--checkpoint",
-    ]);
-    args.push(s(&ckpt));
-    assert_fails(&flapssm(&args), &["run_context.fit"], &out);
-
-    let mut args = train_args(&data, &out, "1");
-    args.extend(["--windows-per-task", "0"]);
-    let o = flapssm(&args);
-    assert_eq!(o.status.code(), Some(2));
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert!(err.contains("--windows-per-task"), "{err}");
+    resume_is_refused(dir, &data, "t1", &["--windows-per-task", "4"]);
+    usage_error(
+        dir,
+        &data,
+        &["--windows-per-task", "0"],
+        &["--windows-per-task"],
+    );
 }
 
 /// `--lengthscale-init L` starts every lengthscale at L: recorded in the model's spec, visible
@@ -436,30 +426,27 @@ fn the_task_size_is_recorded_and_changes_only_rounding() {
 #[test]
 fn the_initial_lengthscale_is_selectable() {
     let dir = tempfile::tempdir().unwrap();
-    let data = simulated(dir.path(), 2, 3);
-    let out = dir.path().join("l.json");
-    let mut args = train_args(&data, &out, "1");
-    args.extend([
-        "--lengthscale-init",
-        "7.5",
-        "--lr",
-        "1e-9",
-        "--val-fraction",
-        "0",
-    ]);
-    ok(&args);
-    let model = json(&out)["model"].clone();
-    assert_eq!(model["training"]["spec"]["init"]["lengthscale"], 7.5);
+    let (dir, data) = (dir.path(), simulated(dir.path(), 2, 3));
+    let (spec, _) = one_epoch(
+        dir,
+        &data,
+        "l",
+        &["--lengthscale-init", "7.5", "--lr", "1e-9"],
+    );
+    assert_eq!(spec["init"]["lengthscale"], 7.5);
+    let model = json(&dir.join("l.json"))["model"].clone();
     for l in model["params"]["lengthscales"].as_array().unwrap() {
         assert!((l.as_f64().unwrap() - 7.5).abs() < 1e-6, "{l}");
     }
-    let bad = dir.path().join("bad.json");
+    let bad = dir.join("bad.json");
     let mut args = train_args(&data, &bad, "1");
     args.extend(["--lengthscale-init", "0"]);
     let o = flapssm(&args);
-    assert!(!o.status.success());
     let err = String::from_utf8_lossy(&o.stderr);
-    assert!(err.contains("lengthscale_init"), "{err}");
+    assert!(
+        !o.status.success() && err.contains("lengthscale_init"),
+        "{err}"
+    );
 }
 
 /// `--preset paper-fast` trains with its own precision, task size and initial lengthscale
@@ -467,20 +454,13 @@ fn the_initial_lengthscale_is_selectable() {
 #[test]
 fn the_fast_preset_brings_its_settings_and_flags_override_them() {
     let dir = tempfile::tempdir().unwrap();
-    let data = simulated(dir.path(), 2, 3);
-    let spec_of = |name: &str, extra: &[&str]| {
-        let out = dir.path().join(format!("{name}.json"));
-        let mut args = train_args(&data, &out, "1");
-        args.extend(["--preset", "paper-fast", "--val-fraction", "0"]);
-        args.extend(extra);
-        ok(&args);
-        json(&out)["model"]["training"]["spec"].clone()
-    };
-    let fast = spec_of("fast", &[]);
+    let (dir, data) = (dir.path(), simulated(dir.path(), 2, 3));
+    let (fast, _) = one_epoch(dir, &data, "fast", &["--preset", "paper-fast"]);
     assert_eq!(fast["precision"], "mixed");
     assert_eq!(fast["windows_per_task"], 2);
     assert_eq!(fast["init"]["lengthscale"], 10.0);
-    let f64_spec = spec_of("fast64", &["--precision", "f64"]);
+    let flags = ["--preset", "paper-fast", "--precision", "f64"];
+    let (f64_spec, _) = one_epoch(dir, &data, "fast64", &flags);
     assert_eq!(f64_spec["precision"], "f64");
     assert_eq!(f64_spec["init"]["lengthscale"], 10.0);
 }

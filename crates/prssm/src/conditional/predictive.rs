@@ -2,9 +2,9 @@
 
 use faer::Accum;
 
-use super::Posterior;
+use super::{Posterior, forward_product};
 use crate::kernel;
-use crate::linalg::{dot, f32_operand, gemm, round_into, view, view_mut, widen_into};
+use crate::linalg::{dot, f32_operand, gemm, view, view_mut, widen_into};
 use crate::params::CovarianceStructure;
 use crate::precision::Precision;
 
@@ -26,9 +26,9 @@ pub(crate) struct PredictiveWorkspace {
     tau_shared: Vec<f64>,
     /// Variances `σ²`, column-major `D_x × N`.
     pub var: Vec<f64>,
-    /// `f32` operands and results under [`Precision::Mixed`]: `K` (`M × N`), `[W; μ]`
-    /// (`(M + D_x) × N`), `W⊙W` (`M × N`), `S(W⊙W)` (`D_x × N`).
-    mixed: Option<[Vec<f32>; 4]>,
+    /// `f32` operands and results under [`Precision::Mixed`]: `K`, then `W⊙W` (`M × N`),
+    /// `[W; μ]` (`(M + D_x) × N`), `S(W⊙W)` (`D_x × N`).
+    mixed: Option<[Vec<f32>; 3]>,
 }
 
 impl PredictiveWorkspace {
@@ -46,14 +46,8 @@ impl PredictiveWorkspace {
             w2: vec![0.0; m * n],
             tau_shared: vec![0.0; m],
             var: vec![0.0; dx * n],
-            mixed: (post.precision() == Precision::Mixed).then(|| {
-                [
-                    vec![0.0; m * n],
-                    vec![0.0; (m + dx) * n],
-                    vec![0.0; m * n],
-                    vec![0.0; dx * n],
-                ]
-            }),
+            mixed: (post.precision() == Precision::Mixed)
+                .then(|| [vec![0.0; m * n], vec![0.0; (m + dx) * n], vec![0.0; dx * n]]),
         }
     }
 
@@ -81,30 +75,15 @@ impl PredictiveWorkspace {
             &mut self.k[..m * n],
             &mut self.tau_shared,
         );
-        let mixed = match self.mixed.as_mut() {
-            None => {
-                gemm(
-                    view_mut(&mut self.wm, r, n),
-                    Accum::Replace,
-                    post.g_mean(),
-                    view(&self.k, m, n),
-                    1.0,
-                );
-                None
-            }
-            Some([k32, wm32, w2_32, var32]) => {
-                round_into(&self.k[..m * n], k32);
-                gemm(
-                    view_mut(wm32, r, n),
-                    Accum::Replace,
-                    post.g_mean32(),
-                    view(k32, m, n),
-                    1.0,
-                );
-                widen_into(&wm32[..r * n], &mut self.wm, Accum::Replace);
-                Some((&mut w2_32[..], &mut var32[..]))
-            }
-        };
+        let products = self
+            .mixed
+            .as_mut()
+            .map(|[k, wm, _]| (&mut k[..], &mut wm[..]));
+        forward_product(post, &self.k, n, &mut self.wm, products);
+        let mixed = self
+            .mixed
+            .as_mut()
+            .map(|[w2, _, var]| (&mut w2[..], &mut var[..]));
         let k = if post.whitened {
             None
         } else {

@@ -3,8 +3,8 @@
 
 use faer::Accum;
 
-use super::Posterior;
 use super::predictive::write_predictive_variance;
+use super::{Posterior, forward_product};
 use crate::kernel;
 use crate::linalg::{dot, f32_operand, gemm, round_into, view, view_mut, widen_into};
 use crate::params::CovarianceStructure;
@@ -220,26 +220,11 @@ impl ConditionalWorkspace {
             &mut self.rowsum,
         );
         let r = m + dx;
-        match self.mixed.as_mut() {
-            None => gemm(
-                view_mut(t.wm, r, n),
-                Accum::Replace,
-                post.g_mean(),
-                view(k, m, n),
-                1.0,
-            ),
-            Some(mx) => {
-                round_into(k, &mut mx.k);
-                gemm(
-                    view_mut(&mut mx.wm, r, n),
-                    Accum::Replace,
-                    post.g_mean32(),
-                    view(&mx.k, m, n),
-                    1.0,
-                );
-                widen_into(&mx.wm[..r * n], t.wm, Accum::Replace);
-            }
-        }
+        let mixed = self
+            .mixed
+            .as_mut()
+            .map(|mx| (&mut mx.k[..], &mut mx.wm[..]));
+        forward_product(post, k, n, t.wm, mixed);
         let wm = &*t.wm;
         for (mean, col) in self.mean[..dx * n]
             .chunks_exact_mut(dx)
