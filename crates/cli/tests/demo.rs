@@ -275,3 +275,36 @@ fn tiny_demo_evaluate_and_sweep() {
     assert!(!o.status.success());
     assert!(String::from_utf8_lossy(&o.stderr).contains("dataset.npz"));
 }
+
+/// `--full --preset paper-fast` trains the paper's model on the fast schedule under the
+/// published protocol (every training trajectory fitted, batch 4 recorded in the model file);
+/// `--preset` without `--full` and an unknown preset are usage errors.
+#[test]
+fn the_full_demo_takes_the_fast_preset() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("full");
+    let d = dir.to_str().unwrap();
+    #[rustfmt::skip]
+    ok(&[
+        "demo", "--full", "--preset", "paper-fast", "--out", d, "--trajectories", "8",
+        "--epochs", "1", "--dx", "6", "--inducing", "8", "--particles", "2",
+    ]);
+    let s = json(&dir.join("summary.json"));
+    assert_eq!(
+        (s["n_train"].as_u64(), s["n_test"].as_u64()),
+        (Some(7), Some(1))
+    );
+    let model = std::fs::read_to_string(dir.join("prssm.json")).unwrap();
+    assert!(model.contains("\"batch_size\": 4"), "{model}");
+    for (flags, needle) in [
+        (&["--preset", "paper-fast"][..], "--full"),
+        (&["--full", "--preset", "nope"][..], "paper-fast"),
+    ] {
+        let mut args = vec!["demo", "--out", d];
+        args.extend(flags);
+        let o = flapssm(&args);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{err}");
+        assert!(err.contains(needle), "{err}");
+    }
+}

@@ -707,4 +707,23 @@ mod tests {
         assert_eq!(default.spec().train.best_by, BestBy::Rmse);
         assert!(default.val_fraction() > 0.0);
     }
+
+    /// `--full --preset paper-fast` changes the training schedule only: the paper's model,
+    /// 100 epochs of minibatches of 4 (12 800 steps), still all 512 fitted and the lowest
+    /// training loss kept.
+    #[test]
+    fn full_with_the_fast_preset_keeps_the_published_protocol() {
+        let mut fast = DemoConfig::full(3);
+        fast.training.preset = flapssm_prssm::train::Preset::PaperFast;
+        let published = DemoConfig::full(3).training.check().unwrap();
+        let published = published.spec();
+        let plan = fast.training.check().unwrap();
+        let spec = plan.spec();
+        assert_eq!(spec.model, published.model);
+        assert_eq!(spec.train.best_by, BestBy::TrainingLoss);
+        assert_eq!(plan.val_fraction(), 0.0);
+        assert_eq!(spec.train.budget, flapssm_prssm::train::Budget::Epochs(100));
+        assert_eq!(spec.train.batch_size, 4);
+        assert_eq!(512usize.div_ceil(spec.train.batch_size) * 100, 12_800);
+    }
 }

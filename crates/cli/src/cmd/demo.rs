@@ -1,6 +1,7 @@
 //! `flapssm demo`: simulate, fit the LRQSM, train the PR-SSM, evaluate and report, resumably.
 
 use flapssm_prssm::Precision;
+use flapssm_prssm::train::Preset;
 use std::path::PathBuf;
 
 use anyhow::Context;
@@ -23,6 +24,11 @@ pub struct DemoArgs {
     /// hours) instead of the default 15-minute one.
     #[arg(long)]
     full: bool,
+    /// The training preset of --full: paper (the published schedule, the default; hours) or
+    /// paper-fast (the paper's model trained for time to quality, minutes; docs/training.md).
+    /// The protocol stays the published one (all 512 fitted, the lowest training loss kept).
+    #[arg(long, requires = "full")]
+    preset: Option<Preset>,
     /// Master seed (simulation, training, prediction).
     #[arg(long, default_value_t = 0)]
     seed: u64,
@@ -94,6 +100,9 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
     } else {
         DemoConfig::default_for(args.seed)
     };
+    if let Some(p) = args.preset {
+        cfg.training.preset = p;
+    }
     if let Some(n) = args.trajectories {
         let t = &mut cfg.simulation.trajectories;
         t.n_trajectories = n;
