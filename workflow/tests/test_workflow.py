@@ -2,7 +2,8 @@
 kind × value × seed and their merge; one demo per seed and their merge), the merged sweep table
 carries the paper's two selection rows with the spread over seeds, the merged demos one row per
 seed and the paper's rows per seed, a second invocation has nothing to do, and the Slurm
-profile plans the same jobs (dry run; no cluster here)."""
+profile plans the same jobs (dry run; no cluster here). The paper's two configurations plan
+their 16 runs each (dry run), the fast one with the fast preset."""
 
 import json
 import os
@@ -18,7 +19,7 @@ WORKFLOW = ROOT / "workflow"
 FLAPSSM = Path(os.environ.get("FLAPSSM", ROOT / "target" / "release" / "flapssm"))
 
 
-def snakemake(*args, cwd):
+def snakemake(*args, cwd, config="tiny.yaml"):
     exe = shutil.which("snakemake", path=str(Path(sys.executable).parent)) or shutil.which(
         "snakemake"
     )
@@ -29,7 +30,7 @@ def snakemake(*args, cwd):
         "--snakefile",
         str(WORKFLOW / "Snakefile"),
         "--configfile",
-        str(WORKFLOW / "config" / "tiny.yaml"),
+        str(WORKFLOW / "config" / config),
         "--config",
         f"flapssm={FLAPSSM}",
         "--directory",
@@ -91,3 +92,16 @@ def test_slurm_profile_plans_the_same_jobs(tmp_path):
         assert any(
             line.split()[:2] == [rule, str(count)] for line in out.splitlines()
         ), out[-4000:]
+
+
+@pytest.mark.parametrize("config,preset", [("paper.yaml", "paper"), ("paper-fast.yaml", "paper-fast")])
+def test_the_paper_configurations_plan_sixteen_runs(tmp_path, config, preset):
+    r = snakemake("--dry-run", "--printshellcmds", "--cores", "2", cwd=tmp_path, config=config)
+    assert r.returncode == 0, r.stderr[-4000:]
+    out = r.stdout + r.stderr
+    for rule, count in [("simulate", 1), ("sweep_run", 16), ("merge", 1)]:
+        assert any(
+            line.split()[:2] == [rule, str(count)] for line in out.splitlines()
+        ), out[-4000:]
+    runs = [line for line in out.splitlines() if " sweep run " in line]
+    assert len(runs) == 16 and all(f"--preset {preset} " in line for line in runs), runs[:2]
