@@ -273,6 +273,10 @@ struct EldredgeRun {
     cl: Vec<f64>,
     /// C_L = −(dI/dt)_Z/(½ρU²c) from the vortex impulse (backward difference, at t − Δt/2).
     cl_impulse: Vec<f64>,
+    /// Chordwise force coefficient along t̂ from the pressure integral (the LE suction).
+    ct: Vec<f64>,
+    /// The same from the vortex impulse (backward difference, at t − Δt/2).
+    ct_impulse: Vec<f64>,
     /// Σ Γ_LEV shed up to t* = 1 + (π/4)/(2K) for K = 0.4 (U c).
     lev_at_ramp_end: f64,
 }
@@ -303,7 +307,8 @@ fn eldredge_run_with(alpha: fn(f64) -> (f64, f64), dt: f64) -> EldredgeRun {
     let mut ldvm = Ldvm::new(p).unwrap();
     let mut onset = None;
     let (mut t_out, mut cl, mut cl_imp) = (vec![], vec![], vec![]);
-    let mut i_prev = [0.0; 2];
+    let (mut ct, mut ct_imp) = (vec![], vec![]);
+    let (mut i_prev, mut angle_prev) = ([0.0; 2], 0.0);
     let mut lev_at_ramp_end = 0.0;
     for k in 0..((5.0 / dt) as usize) {
         let t = k as f64 * dt;
@@ -339,13 +344,18 @@ fn eldredge_run_with(alpha: fn(f64) -> (f64, f64), dt: f64) -> EldredgeRun {
         t_out.push(t);
         cl.push(lift_drag(&l, plate.angle_rad).0 / q);
         cl_imp.push(-(imp[1] - i_prev[1]) / dt / q);
+        ct.push(l.chord_n_m / q);
+        ct_imp.push(chordwise_from_impulse(i_prev, imp, angle_prev, plate.angle_rad, dt) / q);
         i_prev = imp;
+        angle_prev = plate.angle_rad;
     }
     EldredgeRun {
         onset: onset.expect("the LEV must be shed"),
         t: t_out,
         cl,
         cl_impulse: cl_imp,
+        ct,
+        ct_impulse: ct_imp,
         lev_at_ramp_end,
     }
 }
@@ -1194,65 +1204,24 @@ fn rotating_plate_chordwise_force_equals_the_impulse() {
 #[test]
 #[ignore]
 fn study_chordwise_force_with_lev_shedding() {
-    let (c, u, rho) = (1.0, 1.0, 1.0);
     for dt in [0.015, 0.0075] {
-        let m = Motion {
-            u,
-            alpha: eldredge,
-            h: zero,
-        };
-        let p = LdvmParams {
-            chord_m: c,
-            u_ref_m_s: u,
-            rho_kg_m3: rho,
-            pivot_frac: 0.0,
-            lesp_crit: Some(0.11),
-            lev_decay_chords: None,
-            tev_decay_chords: None,
-            far_field_chords: None,
-            max_vortices: (12.0 / dt) as usize,
-            ..LdvmParams::default()
-        };
-        let mut ldvm = Ldvm::new(p).unwrap();
-        let (mut i_prev, mut a_prev, mut t_prev) = ([0.0; 2], 0.0, 0.0);
-        let (mut tp, mut ti, mut ts) = (vec![], vec![], vec![]);
-        for k in 0..((5.0 / dt) as usize) {
-            let t = k as f64 * dt;
-            let plate = plate_at(&m, t);
-            let l = ldvm.step(&plate, dt).unwrap();
-            let imp = impulse(&ldvm, &plate, c, rho);
-            if k > 0 {
-                ti.push(chordwise_from_impulse(
-                    i_prev,
-                    imp,
-                    a_prev,
-                    plate.angle_rad,
-                    dt,
-                ));
-                tp.push(0.5 * (l.chord_n_m + t_prev));
-                ts.push(t);
-            }
-            i_prev = imp;
-            a_prev = plate.angle_rad;
-            t_prev = l.chord_n_m;
-        }
+        let r = eldredge_run_with(eldredge, dt);
         let h = (0.075 / dt).round() as usize;
-        let q = 0.5 * rho * u * u * c;
-        let (tp, ti) = (smooth(&tp, h), smooth(&ti, h));
+        let (ct, cti) = (smooth(&r.ct, h), smooth(&r.ct_impulse, h));
         let mean = |v: &[f64], lo: f64, hi: f64| {
-            let sel: Vec<f64> = ts
-                .iter()
-                .zip(v)
-                .filter(|(t, _)| **t >= lo && **t < hi)
-                .map(|(_, x)| x / q)
-                .collect();
+            let sel: Vec<f64> =
+                r.t.iter()
+                    .zip(v)
+                    .filter(|(t, _)| **t >= lo && **t < hi)
+                    .map(|(_, x)| *x)
+                    .collect();
             sel.iter().sum::<f64>() / sel.len() as f64
         };
         for (lo, hi) in [(1.0, ELDREDGE_T2), (ELDREDGE_T2, 3.0), (3.0, 5.0)] {
             println!(
                 "dt* = {dt}: t* in [{lo:.2}, {hi:.2}): mean C_T pressure {:.3}, impulse {:.3}",
-                mean(&tp, lo, hi),
-                mean(&ti, lo, hi)
+                mean(&ct, lo, hi),
+                mean(&cti, lo, hi)
             );
         }
     }
