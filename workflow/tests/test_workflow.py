@@ -3,7 +3,8 @@ kind × value × seed and their merge; one demo per seed and their merge), the m
 carries the paper's two selection rows with the spread over seeds, the merged demos one row per
 seed and the paper's rows per seed, a second invocation has nothing to do, and the Slurm
 profile plans the same jobs (dry run; no cluster here). The paper's two configurations plan
-their 16 runs each (dry run), the fast one with the fast preset."""
+their 16 runs each (dry run), the fast one with the fast preset; the paper's experiment on three
+seeds plans three `demo --full --preset paper-fast` runs (a `true` option is a bare switch)."""
 
 import json
 import os
@@ -105,3 +106,13 @@ def test_the_paper_configurations_plan_sixteen_runs(tmp_path, config, preset):
         ), out[-4000:]
     runs = [line for line in out.splitlines() if " sweep run " in line]
     assert len(runs) == 16 and all(f"--preset {preset} " in line for line in runs), runs[:2]
+
+
+def test_the_full_demo_on_three_seeds_plans_switches(tmp_path):
+    r = snakemake(
+        "--dry-run", "--printshellcmds", "--cores", "2", cwd=tmp_path, config="paper-full.yaml"
+    )
+    assert r.returncode == 0, r.stderr[-4000:]
+    runs = [line for line in (r.stdout + r.stderr).splitlines() if " demo --out " in line]
+    assert len(runs) == 3, runs
+    assert all("--full --preset paper-fast" in line and "True" not in line for line in runs), runs
