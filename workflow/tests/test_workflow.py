@@ -41,6 +41,14 @@ def snakemake(*args, cwd, config="tiny.yaml"):
     return subprocess.run(cmd, capture_output=True, text=True, timeout=600)
 
 
+def assert_planned(out, counts):
+    """Snakemake's job-stats table in `out` lists each (rule, count)."""
+    for rule, count in counts:
+        assert any(
+            line.split()[:2] == [rule, str(count)] for line in out.splitlines()
+        ), out[-4000:]
+
+
 def test_tiny_workflow_runs_merges_and_resumes(tmp_path):
     assert FLAPSSM.exists(), f"{FLAPSSM}: build it first (cargo build --release -p flapssm)"
     r = snakemake("--profile", str(WORKFLOW / "profiles" / "local"), cwd=tmp_path)
@@ -82,17 +90,10 @@ def test_slurm_profile_plans_the_same_jobs(tmp_path):
         cwd=tmp_path,
     )
     assert r.returncode == 0, r.stderr[-4000:]
-    out = r.stdout + r.stderr
-    for rule, count in [
-        ("simulate", 1),
-        ("sweep_run", 6),
-        ("merge", 1),
-        ("demo_run", 2),
-        ("demo_merge", 1),
-    ]:
-        assert any(
-            line.split()[:2] == [rule, str(count)] for line in out.splitlines()
-        ), out[-4000:]
+    assert_planned(
+        r.stdout + r.stderr,
+        [("simulate", 1), ("sweep_run", 6), ("merge", 1), ("demo_run", 2), ("demo_merge", 1)],
+    )
 
 
 @pytest.mark.parametrize("config,preset", [("paper.yaml", "paper"), ("paper-fast.yaml", "paper-fast")])
@@ -100,10 +101,7 @@ def test_the_paper_configurations_plan_sixteen_runs(tmp_path, config, preset):
     r = snakemake("--dry-run", "--printshellcmds", "--cores", "2", cwd=tmp_path, config=config)
     assert r.returncode == 0, r.stderr[-4000:]
     out = r.stdout + r.stderr
-    for rule, count in [("simulate", 1), ("sweep_run", 16), ("merge", 1)]:
-        assert any(
-            line.split()[:2] == [rule, str(count)] for line in out.splitlines()
-        ), out[-4000:]
+    assert_planned(out, [("simulate", 1), ("sweep_run", 16), ("merge", 1)])
     runs = [line for line in out.splitlines() if " sweep run " in line]
     assert len(runs) == 16 and all(f"--preset {preset} " in line for line in runs), runs[:2]
 

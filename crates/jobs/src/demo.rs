@@ -724,6 +724,9 @@ mod tests {
         assert_eq!(plan.val_fraction(), 0.0);
         assert_eq!(spec.train.budget, flapssm_prssm::train::Budget::Epochs(100));
         assert_eq!(spec.train.batch_size, 4);
-        assert_eq!(512usize.div_ceil(spec.train.batch_size) * 100, 12_800);
+        let trajectories = vec![crate::test_data::tiny_dataset().trajectories[0].clone(); 512];
+        let (fit, val) = plan.split(&trajectories).unwrap();
+        assert_eq!((fit.len(), val.len()), (512, 0));
+        assert_eq!(fit.len().div_ceil(spec.train.batch_size) * 100, 12_800);
     }
 }

@@ -1102,8 +1102,8 @@ fn leading_edge_suction_follows_wagner_squared() {
 }
 
 /// Chordwise force along t̂ (N/m) from the impulse: −(I_k − I_{k−1})/Δt projected on the
-/// chord direction at the mid-step angle, and the pressure-integral value averaged over the
-/// same two steps (the difference is centred half a step earlier).
+/// chord direction at the mid-step angle (the difference is centred half a step earlier, so
+/// callers set it beside the pressure integral's value averaged over the same two steps).
 fn chordwise_from_impulse(
     i_prev: [f64; 2],
     i_now: [f64; 2],
