@@ -468,9 +468,11 @@ pub fn train<O: Objective + ?Sized>(
     let mut resumed_from = None;
     let mut state = match resume {
         Some(ck) => {
-            // Only the budget may grow: the run is then extended from where it stopped.
+            // Only the budget may grow (the run is then extended from where it stopped) and the
+            // checkpoint interval change: neither touches the arithmetic of a step.
             let same_budget = TrainConfig {
                 budget: config.budget,
+                checkpoint_every: config.checkpoint_every,
                 ..ck.config.clone()
             };
             if let Some((field, why)) = config_difference(&same_budget, config) {
