@@ -102,6 +102,9 @@ mod tests {
         // The measured set's U_ref is one value (0.1746 m/s to ±0.5 %).
         let u = &rows[7];
         assert!(u.paper[0] > 0.17 && u.paper[2] < 0.18, "{u:?}");
+        // The default generator's frequencies are the measured ones (every trajectory counted).
+        let f = &rows[0];
+        assert!(f.ks.p_value > 0.01, "{f:?}");
         // Twice the frequency and nothing else changed: the KS test sees it.
         let fast = GeneratorConfig {
             frequency_hz: [0.4, 0.5],

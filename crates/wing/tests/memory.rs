@@ -260,6 +260,7 @@ fn xcorr_peak_lags(ds: &Dataset, freqs: &[f64], residuals: &[Vec<f64>]) -> Vec<f
         let mr = res.iter().sum::<f64>() / n as f64;
         let sa = (a.iter().map(|v| (v - ma).powi(2)).sum::<f64>() / n as f64).sqrt();
         let sr = (res.iter().map(|v| (v - mr).powi(2)).sum::<f64>() / n as f64).sqrt();
+        assert!(f.is_finite() && *f > 0.0, "stroke frequency {f}");
         let period = 1.0 / (f * ds.dt_s);
         let max_lag = period.floor() as usize;
         let mut best = (0.0, 0usize);

@@ -121,3 +121,77 @@ fn the_named_test_trajectories_have_the_shapes_of_fig_3() {
         .fold(0.0, f64::max);
     assert!(flat < 5.0 * deg, "#33: |ψ| up to {flat}");
 }
+
+#[test]
+fn every_measured_trajectory_has_a_stroke_frequency() {
+    use flapssm_wing::trajectories::stats::TrajectoryStats;
+    for (i, t) in paper_angles(PAPER_N_TRAJECTORIES).iter().enumerate() {
+        let f = TrajectoryStats::of(t, PAPER_DT_S)
+            .unwrap()
+            .stroke_frequency_hz;
+        assert!((0.08..0.3).contains(&f), "trajectory {i}: {f} Hz");
+    }
+}
+
+/// What sets the stroke frequency, in the measured set and the generator's (seed 1, 548): per
+/// trajectory over samples 93.., U_ref / (R · mean tip path rate), the stroke's path over 4Φ, and
+/// e, the whole tip path over the stroke's; 5 / 50 / 95th percentiles (docs/kinematics.md). A
+/// study: `cargo test --release -p flapssm-wing --test paper_trajectories
+/// study_frequency_and_tip_path -- --ignored --nocapture`.
+#[test]
+#[ignore = "study: what sets the stroke frequency"]
+fn study_frequency_and_tip_path() {
+    use flapssm_wing::cycles::U_REF_RADIUS_M;
+    use flapssm_wing::trajectories::stats::TrajectoryStats;
+    use flapssm_wing::trajectories::{GeneratorConfig, default_n_train};
+    let cfg = GeneratorConfig {
+        n_trajectories: 548,
+        n_train: default_n_train(548),
+        seed: 1,
+        ..GeneratorConfig::default()
+    };
+    let generated: Vec<Vec<[f64; 3]>> = cfg
+        .generate()
+        .unwrap()
+        .iter()
+        .map(|sp| {
+            sp.sample_dataset(&cfg.sampling)
+                .iter()
+                .map(|e| e.angles_rad)
+                .collect()
+        })
+        .collect();
+    for (name, set) in [
+        ("paper", paper_angles(PAPER_N_TRAJECTORIES)),
+        ("generator", generated),
+    ] {
+        let mut cols = [Vec::new(), Vec::new(), Vec::new(), Vec::new()];
+        for a in &set {
+            let st = TrajectoryStats::of(a, PAPER_DT_S).unwrap();
+            let w = &a[START..];
+            let (mut path, mut stroke_path) = (0.0, 0.0);
+            for p in w.windows(2) {
+                path += (p[1][0] - p[0][0]).hypot(p[1][1] - p[0][1]);
+                stroke_path += (p[1][0] - p[0][0]).abs();
+            }
+            let t = (w.len() - 1) as f64 * PAPER_DT_S;
+            let per_cycle = stroke_path / t / st.stroke_frequency_hz;
+            cols[0].push(st.stroke_frequency_hz);
+            cols[1].push(st.u_ref_m_s / (U_REF_RADIUS_M * path / t));
+            cols[2].push(per_cycle / (4.0 * st.stroke_half_amplitude_deg.to_radians()));
+            cols[3].push(path / stroke_path);
+        }
+        let q = |v: &mut Vec<f64>| {
+            v.sort_by(f64::total_cmp);
+            let n = v.len();
+            format!("{:.3} / {:.3} / {:.3}", v[n / 20], v[n / 2], v[n * 19 / 20])
+        };
+        println!(
+            "{name}: f (Hz) {}; U_ref/(R·path rate) {}; stroke path per cycle/4Φ {}; e {}",
+            q(&mut cols[0]),
+            q(&mut cols[1]),
+            q(&mut cols[2]),
+            q(&mut cols[3])
+        );
+    }
+}
