@@ -962,6 +962,52 @@ fn strip_hover_circulation_stays_bounded() {
 /// and has no bound circulation, so its only load is the chordwise drag −C_D0·½ρcU² against
 /// the motion (C_D0 = 0.260, the L0 model's zero-incidence drag at Re = 1000), for either
 /// direction; `profile_drag = 0` gives the inviscid plate's zero load.
+/// The LESP reference speed forgets how the motion began: a strip that first crept at
+/// 0.02 m/s for 10 s and one started at once reach the same U_ref once both have travelled
+/// 40 chords at 0.2 m/s (weights e^{−s/4c}: the creep's 10 s count as 5e-4 s against the fast
+/// phase's 1.2 s). With `reference_speed_chords: None` (the mean since the start) the creep
+/// still takes U_ref below 0.12 m/s.
+#[test]
+fn strip_reference_speed_forgets_the_history() {
+    let geom = rcp_section();
+    let u_ref = |params: StripLdvmParams, creep: bool| {
+        let mut strip = StripLdvm::new(params, &geom);
+        let at = |v: f64| SectionKinematics {
+            chord_velocity_m_s: -v,
+            ..Default::default()
+        };
+        let dt = 0.004;
+        strip.step(&at(if creep { 0.02 } else { 0.2 }), 0.0);
+        if creep {
+            for _ in 0..2500 {
+                strip.step(&at(0.02), dt);
+            }
+        }
+        // 40 chords at 0.2 m/s: 2.4 m in 12 s
+        for _ in 0..3000 {
+            strip.step(&at(0.2), dt);
+        }
+        strip.ldvm().unwrap().reference_speed()
+    };
+    let recent = StripLdvmParams::default();
+    let (a, b) = (u_ref(recent, false), u_ref(recent, true));
+    assert!(
+        (a - 0.2).abs() < 1e-9 && (b - 0.2).abs() < 0.002 * 0.2,
+        "{a} {b}"
+    );
+    let since_start = StripLdvmParams {
+        reference_speed_chords: None,
+        ..recent
+    };
+    let (a, b) = (u_ref(since_start, false), u_ref(since_start, true));
+    assert!((a - 0.2).abs() < 1e-9 && b < 0.6 * 0.2, "{a} {b}");
+    let bad = StripLdvmParams {
+        reference_speed_chords: Some(0.0),
+        ..recent
+    };
+    assert!(bad.check(&geom).is_err());
+}
+
 #[test]
 fn strip_profile_drag_at_zero_incidence() {
     use flapssm_wing::vortex::strip::zero_incidence_drag;
@@ -1225,4 +1271,84 @@ fn study_chordwise_force_with_lev_shedding() {
             );
         }
     }
+}
+
+#[test]
+#[ignore = "probe"]
+fn probe_bursts() {
+    use flapssm_wing::trajectories::SamplingConfig;
+    use flapssm_wing::trajectories::measured::raw_states;
+    use flapssm_wing::trajectories::paper::paper_angles;
+    use flapssm_wing::virtual_wing::VirtualWingConfig;
+    let sampling = SamplingConfig::default();
+    let dt = 1.0 / sampling.raw_rate_hz;
+    let mut params = VirtualWingConfig::default().l2;
+    if let Some(k) = std::env::var("PROBE_NCHORD")
+        .ok()
+        .and_then(|s| s.parse().ok())
+    {
+        params.ldvm.n_chord = k;
+    }
+    if let Some(k) = std::env::var("PROBE_NF").ok().and_then(|s| s.parse().ok()) {
+        params.ldvm.n_fourier = k;
+    }
+    if let Some(k) = std::env::var("PROBE_RC").ok().and_then(|s| s.parse().ok()) {
+        params.ldvm.core_radius_frac = k;
+    }
+    let geom = rcp_section();
+    let qs = QuasiSteadySection::new(geom, QuasiSteadyParams::default());
+    let n: usize = std::env::var("PROBE_N")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(150);
+    let show: Option<usize> = std::env::var("PROBE_SHOW")
+        .ok()
+        .and_then(|s| s.parse().ok());
+    let mut worst = (0.0, 0);
+    let mut bursts = 0;
+    for (t, angles) in paper_angles(n).iter().enumerate() {
+        if show.is_some_and(|s| s != t) {
+            continue;
+        }
+        let states = raw_states(angles, &sampling).expect("measured states");
+        let mut strip = StripLdvm::new(params, &geom);
+        let (mut pk, mut pq, mut at) = (0.0f64, 0.0f64, 0);
+        let mut rows = Vec::new();
+        for (i, s) in states.iter().enumerate() {
+            let kin = section_kin(s, R_CP_M);
+            let l = strip.step(&kin, if i == 0 { 0.0 } else { dt });
+            let q = qs.loads(&kin).normal_n_m;
+            if i >= 250 {
+                if l.normal_n_m.abs() > pk {
+                    pk = l.normal_n_m.abs();
+                    at = i;
+                }
+                pq = pq.max(q.abs());
+            }
+            if show.is_some() {
+                let d = strip.ldvm().unwrap().diagnostics();
+                rows.push(format!(
+                    "{i} v {:.3} om {:.2} | N {:.2} QS {:.2} | lesp0 {:.2} lesp {:.2} tev {:.2e} lev {:.2e} nv {} terms {:.1} {:.1} {:.1} {:.1}",
+                    kin.speed_m_s(), kin.rotation_rate_rad_s, l.normal_n_m, q, d.lesp_unshed, d.lesp, d.tev_m2_s, d.lev_m2_s, d.n_vortices,
+                    d.normal_terms_n_m[0], d.normal_terms_n_m[1], d.normal_terms_n_m[2], d.normal_terms_n_m[3]
+                ));
+            }
+        }
+        let r = pk / (1.5 * pq + 1.0 / 0.18);
+        if r > 1.0 {
+            bursts += 1;
+        }
+        if r > worst.0 {
+            worst = (r, t);
+        }
+        if show.is_some() {
+            println!("traj {t}: peak {pk:.2} at {at}, QS peak {pq:.2}");
+            for row in &rows[at.saturating_sub(12)..(at + 8).min(rows.len())] {
+                println!("{row}");
+            }
+        } else if r > 1.0 {
+            println!("traj {t}: ratio {r:.2} peak {pk:.2} at {at} QS {pq:.2}");
+        }
+    }
+    println!("{bursts} bursts, worst {:.2} at {}", worst.0, worst.1);
 }

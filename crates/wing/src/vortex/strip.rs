@@ -12,10 +12,21 @@
 //!
 //! # Reference speed
 //!
-//! LESP = B0/U_ref with U_ref(t) = (1/t) ∫₀ᵗ |v| dt, the mean section speed since the start
-//! (→ the cycle-mean speed, the `fplotter.m` definition at this radius). It needs no prior
-//! knowledge of the trajectory and scales with the motion, so coefficients are invariant under
-//! time scaling.
+//! LESP = B0/U_ref with U_ref the section's mean speed over its recent travel: the travel over
+//! the time it took, each weighted by e^{−s/(s_U·c)} with s the travel since (m),
+//!
+//! ```text
+//! U_ref = ∫ e^{−s/(s_U c)} ds / ∫ e^{−s/(s_U c)} dt,
+//! ```
+//!
+//! s_U = `reference_speed_chords` (default 4, the wake's decay length: what the plate has left
+//! more than 4 chords behind it no longer sets its flow). It needs no prior knowledge of the
+//! trajectory and scales with the motion, so coefficients are invariant under time scaling, and
+//! it forgets how the motion began. With `None` it is the mean speed since the start,
+//! (1/t) ∫₀ᵗ |v| dt (before issue 27, part 5): two histories of the same kinematics then kept
+//! different LESP thresholds for the whole trajectory, and the chordwise loads of one trajectory
+//! reached through ramp-ins of 0.5 s and 3.72 s still differed by 0.24 σ three cycles later
+//! (0.06 σ with s_U = 4; docs/vortex-method.md, round 11).
 //!
 //! # Sub-steps
 //!
@@ -83,6 +94,9 @@ pub struct StripLdvmParams {
     /// Chordwise profile-drag coefficient C_D0 (dimensionless, default
     /// [`zero_incidence_drag`] = 0.260; 0 gives the inviscid plate).
     pub profile_drag: f64,
+    /// Travel s_U (chords) over which the LESP reference speed averages, exponentially weighted
+    /// (default 4); `None`: the mean speed since the start (module docs, "Reference speed").
+    pub reference_speed_chords: Option<f64>,
 }
 
 impl StripLdvmParams {
@@ -106,6 +120,15 @@ impl StripLdvmParams {
             return Err(VortexError::InvalidParameter {
                 name,
                 value,
+                reason: "must be finite and > 0",
+            });
+        }
+        if let Some(s_u) = self.reference_speed_chords
+            && !(s_u.is_finite() && s_u > 0.0)
+        {
+            return Err(VortexError::InvalidParameter {
+                name: "reference_speed_chords",
+                value: s_u,
                 reason: "must be finite and > 0",
             });
         }
@@ -140,6 +163,7 @@ impl Default for StripLdvmParams {
             max_step_chords: 0.0125,
             max_substeps: 8,
             profile_drag: zero_incidence_drag(),
+            reference_speed_chords: Some(4.0),
         }
     }
 }
@@ -166,11 +190,13 @@ pub struct StripLdvm {
     drag_factor: f64,
     max_step_m: f64,
     max_substeps: usize,
+    /// s_U·c (m), or infinite (mean since the start).
+    reference_travel_m: f64,
     prev_kin: SectionKinematics,
     plate: PlateState,
     started: bool,
-    time_s: f64,
-    distance_m: f64,
+    recent_time_s: f64,
+    recent_travel_m: f64,
     prev_speed_m_s: f64,
 }
 
@@ -187,11 +213,14 @@ impl StripLdvm {
             drag_factor: params.profile_drag * 0.5 * section.density_kg_m3 * section.chord_m,
             max_step_m: params.max_step_chords * section.chord_m,
             max_substeps: params.max_substeps,
+            reference_travel_m: params
+                .reference_speed_chords
+                .map_or(f64::INFINITY, |s_u| s_u * section.chord_m),
             prev_kin: SectionKinematics::default(),
             plate: PlateState::default(),
             started: false,
-            time_s: 0.0,
-            distance_m: 0.0,
+            recent_time_s: 0.0,
+            recent_travel_m: 0.0,
             prev_speed_m_s: 0.0,
         }
     }
@@ -222,8 +251,8 @@ impl SectionModel for StripLdvm {
         }
         self.plate = PlateState::default();
         self.started = false;
-        self.time_s = 0.0;
-        self.distance_m = 0.0;
+        self.recent_time_s = 0.0;
+        self.recent_travel_m = 0.0;
         self.prev_speed_m_s = 0.0;
         self.prev_kin = SectionKinematics::default();
     }
@@ -308,16 +337,19 @@ impl StripLdvm {
             self.plate.pivot_m[1] += 0.5 * (prev_vel[1] + vel[1]) * dt;
             self.plate.angle_rad = angle;
             self.plate.pivot_vel_m_s = vel;
-            self.time_s += dt;
-            self.distance_m += 0.5 * (self.prev_speed_m_s + speed) * dt;
+            // the travel and time of the recent motion, older parts weighted by e^{−s/(s_U c)}
+            let ds = 0.5 * (self.prev_speed_m_s + speed) * dt;
+            let keep = (-ds / self.reference_travel_m).exp();
+            self.recent_time_s = keep * self.recent_time_s + dt;
+            self.recent_travel_m = keep * self.recent_travel_m + ds;
         } else {
             self.plate.pivot_vel_m_s = Self::inertial_velocity(0.0, kin);
         }
         self.plate.angle_rate_rad_s = omega;
         self.prev_speed_m_s = speed;
         self.prev_kin = *kin;
-        let u_ref = if self.time_s > 0.0 {
-            self.distance_m / self.time_s
+        let u_ref = if self.recent_time_s > 0.0 {
+            self.recent_travel_m / self.recent_time_s
         } else {
             speed
         };
