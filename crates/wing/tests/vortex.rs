@@ -958,10 +958,6 @@ fn strip_hover_circulation_stays_bounded() {
     assert!(max_normal < 60.0, "max |N'| = {max_normal} N/m");
 }
 
-/// Profile drag: a strip sliding along its chord (zero incidence, no rotation) sheds nothing
-/// and has no bound circulation, so its only load is the chordwise drag −C_D0·½ρcU² against
-/// the motion (C_D0 = 0.260, the L0 model's zero-incidence drag at Re = 1000), for either
-/// direction; `profile_drag = 0` gives the inviscid plate's zero load.
 /// The LESP reference speed forgets how the motion began: a strip that first crept at
 /// 0.02 m/s for 10 s and one started at once reach the same U_ref once both have travelled
 /// 40 chords at 0.2 m/s (weights e^{−s/4c}: the creep's 10 s count as 5e-4 s against the fast
@@ -1008,6 +1004,10 @@ fn strip_reference_speed_forgets_the_history() {
     assert!(bad.check(&geom).is_err());
 }
 
+/// Profile drag: a strip sliding along its chord (zero incidence, no rotation) sheds nothing
+/// and has no bound circulation, so its only load is the chordwise drag −C_D0·½ρcU² against
+/// the motion (C_D0 = 0.260, the L0 model's zero-incidence drag at Re = 1000), for either
+/// direction; `profile_drag = 0` gives the inviscid plate's zero load.
 #[test]
 fn strip_profile_drag_at_zero_incidence() {
     use flapssm_wing::vortex::strip::zero_incidence_drag;
