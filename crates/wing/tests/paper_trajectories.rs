@@ -143,23 +143,19 @@ fn every_measured_trajectory_has_a_stroke_frequency() {
 fn study_frequency_and_tip_path() {
     use flapssm_wing::cycles::U_REF_RADIUS_M;
     use flapssm_wing::trajectories::stats::TrajectoryStats;
-    use flapssm_wing::trajectories::{GeneratorConfig, default_n_train};
+    use flapssm_wing::trajectories::{GeneratorConfig, default_n_train, kinematics_dataset};
     let cfg = GeneratorConfig {
         n_trajectories: 548,
         n_train: default_n_train(548),
         seed: 1,
         ..GeneratorConfig::default()
     };
-    let generated: Vec<Vec<[f64; 3]>> = cfg
-        .generate()
+    let generated: Vec<Vec<[f64; 3]>> = kinematics_dataset(&cfg)
         .unwrap()
-        .iter()
-        .map(|sp| {
-            sp.sample_dataset(&cfg.sampling)
-                .iter()
-                .map(|e| e.angles_rad)
-                .collect()
-        })
+        .into_inner()
+        .trajectories
+        .into_iter()
+        .map(|t| t.euler_rad)
         .collect();
     for (name, set) in [
         ("paper", paper_angles(PAPER_N_TRAJECTORIES)),
