@@ -52,6 +52,8 @@ def main():
         names = list(d["output_names"])
     except (OSError, KeyError, ValueError) as e:
         sys.exit(f"error: {a.dataset}: {e}")
+    if u.ndim != 3 or u.shape[1] <= START or y.shape[:2] != u.shape[:2]:
+        sys.exit(f"error: {a.dataset}: u {u.shape} and y {y.shape} need more than {START} samples per trajectory")
     y_rows = {s: y[m][:, START:, :].reshape(-1, y.shape[2]) for s, m in (("train", train), ("test", ~train))}
     sd = y_rows["train"].std(axis=0)
     print(f"{a.dataset}: {train.sum()} training / {(~train).sum()} test trajectories, samples {START}..")
