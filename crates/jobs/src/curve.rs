@@ -12,7 +12,10 @@
 //! Time-to-quality: the **converged** validation RMSE `r∞` is the median of the last 10 % of
 //! a reference curve's evaluated epochs (at least one), where the reference is a run of the
 //! published schedule (Adam 0.03, 1000 epochs); a run reaches quality at its first evaluated
-//! epoch with `val_rmse ≤ (1 + tolerance) · r∞` (tolerance 2 %).
+//! epoch with `val_rmse ≤ (1 + tolerance) · r∞` (tolerance 2 %). One evaluation can dip below
+//! the threshold by luck, so the run is also said to **hold** quality from the first epoch at
+//! which the median of its last [`RUNNING_MEDIAN_WINDOW`] evaluations is at or below it (a
+//! trailing median: what the run had shown by then).
 
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -37,6 +40,8 @@ pub const CURVE_COLUMNS: [&str; 6] = [
 pub const CONVERGED_TAIL: f64 = 0.1;
 /// Relative distance to the converged validation RMSE that counts as reached (2 %).
 pub const QUALITY_TOLERANCE: f64 = 0.02;
+/// Evaluated epochs in the trailing median of [`TimeToQuality::held`].
+pub const RUNNING_MEDIAN_WINDOW: usize = 11;
 
 /// One evaluated epoch.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -236,6 +241,9 @@ pub struct TimeToQuality {
     pub threshold: f64,
     /// The first evaluated epoch at or below the threshold, if any.
     pub reached: Option<CurvePoint>,
+    /// The first evaluated epoch at which the median of the last [`RUNNING_MEDIAN_WINDOW`]
+    /// validation RMSEs (a full window) is at or below the threshold, if any.
+    pub held: Option<CurvePoint>,
     /// The run's last evaluated epoch.
     pub last: CurvePoint,
     /// The run's lowest validation RMSE.
@@ -286,10 +294,24 @@ pub fn time_to_quality(
         expected: "at least one evaluated epoch".into(),
     })?;
     let threshold = (1.0 + tolerance) * converged;
+    let evaluated: Vec<CurvePoint> = run
+        .iter()
+        .copied()
+        .filter(|p| p.val_rmse.is_finite())
+        .collect();
+    let mut window = [0.0; RUNNING_MEDIAN_WINDOW];
+    let held = evaluated.windows(RUNNING_MEDIAN_WINDOW).find_map(|w| {
+        for (slot, p) in window.iter_mut().zip(w) {
+            *slot = p.val_rmse;
+        }
+        window.sort_by(f64::total_cmp);
+        (window[RUNNING_MEDIAN_WINDOW / 2] <= threshold).then(|| w[RUNNING_MEDIAN_WINDOW - 1])
+    });
     Ok(TimeToQuality {
         converged_rmse: converged,
         threshold,
-        reached: run.iter().copied().find(|p| p.val_rmse <= threshold),
+        reached: evaluated.iter().copied().find(|p| p.val_rmse <= threshold),
+        held,
         last,
         best_rmse: run
             .iter()
@@ -352,6 +374,18 @@ mod tests {
         assert_eq!(q.reached.unwrap().epoch, 2);
         assert_eq!(q.reached.unwrap().wall_s, 14.0);
         assert_eq!(q.best_rmse, 0.326);
+        assert!(q.held.is_none(), "three evaluations are no full window");
+        // A lucky dip at epoch 3 is reached but not held; the trailing median of 11 first
+        // comes below the threshold when 6 of the last 11 are: at epoch 15, were epoch 12
+        // evaluated.
+        let mut dip: Vec<CurvePoint> = (0..20)
+            .map(|e| point(e, e as f64, if e >= 10 { 0.32 } else { 0.5 }))
+            .collect();
+        dip[3].val_rmse = 0.30;
+        dip[12].val_rmse = f64::NAN;
+        let q = time_to_quality(&dip, &c, p, QUALITY_TOLERANCE).unwrap();
+        assert_eq!(q.reached.unwrap().epoch, 3);
+        assert_eq!(q.held.unwrap().epoch, 16);
         let slow = [point(0, 5.0, 0.5), point(1, 9.0, 0.4)];
         assert!(
             time_to_quality(&slow, &c, p, QUALITY_TOLERANCE)

@@ -9,7 +9,8 @@ use flapssm_jobs::bench::{
     AUTHORS_EPOCH_S, AUTHORS_PREDICT_S, BenchSettings, bench, speed_against_reference_machine,
 };
 use flapssm_jobs::curve::{
-    CONVERGED_TAIL, QUALITY_TOLERANCE, early_stop_point, read_curve, time_to_quality,
+    CONVERGED_TAIL, QUALITY_TOLERANCE, RUNNING_MEDIAN_WINDOW, early_stop_point, read_curve,
+    time_to_quality,
 };
 use flapssm_prssm::Precision;
 use flapssm_prssm::train::bench::REFERENCE_SOLVE_S;
@@ -90,6 +91,20 @@ fn print_time_to_quality(
             q.last.wall_s / 60.0,
             q.last.val_rmse,
             q.best_rmse
+        ),
+    }
+    match q.held {
+        Some(p) => println!(
+            "  held (median of the last {RUNNING_MEDIAN_WINDOW} evaluations at or below the \
+             threshold) from epoch {} (step {}) after {:.1} s = {:.1} min of training",
+            p.epoch,
+            p.step,
+            p.wall_s,
+            p.wall_s / 60.0
+        ),
+        None => println!(
+            "  not held: the median of no {RUNNING_MEDIAN_WINDOW} consecutive evaluations is at \
+             or below the threshold"
         ),
     }
     if let Some(n) = patience {
