@@ -709,7 +709,7 @@ mod tests {
     }
 
     /// `--full --preset paper-fast` changes the training schedule only: the paper's model,
-    /// 100 epochs of minibatches of 4 (12 800 steps), still all 512 fitted and the lowest
+    /// 300 epochs of minibatches of 4 (38 400 steps), still all 512 fitted and the lowest
     /// training loss kept.
     #[test]
     fn full_with_the_fast_preset_keeps_the_published_protocol() {
@@ -722,11 +722,11 @@ mod tests {
         assert_eq!(spec.model, published.model);
         assert_eq!(spec.train.best_by, BestBy::TrainingLoss);
         assert_eq!(plan.val_fraction(), 0.0);
-        assert_eq!(spec.train.budget, flapssm_prssm::train::Budget::Epochs(100));
+        assert_eq!(spec.train.budget, flapssm_prssm::train::Budget::Epochs(300));
         assert_eq!(spec.train.batch_size, 4);
         let trajectories = vec![crate::test_data::tiny_dataset().trajectories[0].clone(); 512];
         let (fit, val) = plan.split(&trajectories).unwrap();
         assert_eq!((fit.len(), val.len()), (512, 0));
-        assert_eq!(fit.len().div_ceil(spec.train.batch_size) * 100, 12_800);
+        assert_eq!(fit.len().div_ceil(spec.train.batch_size) * 300, 38_400);
     }
 }

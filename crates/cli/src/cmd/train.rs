@@ -24,8 +24,8 @@ pub struct TrainArgs {
     #[arg(long)]
     out: PathBuf,
     /// Named preset: paper (Bayiz & Cheng 2021), paper-fast (the paper's model trained for
-    /// time to quality: initial lengthscales 10, batch 4, 10 particles, mixed precision, 100
-    /// epochs; docs/training.md) or sysid (Doerr et al. 2018).
+    /// time to quality: initial lengthscales 10, batch 4, 10 particles, mixed precision, 300
+    /// epochs with a cosine-annealed rate; docs/training.md) or sysid (Doerr et al. 2018).
     #[arg(long, default_value = "paper")]
     preset: Preset,
     /// Latent dimension D_x.
