@@ -299,25 +299,28 @@ pub fn time_to_quality(
         .copied()
         .filter(|p| p.val_rmse.is_finite())
         .collect();
-    let mut window = [0.0; RUNNING_MEDIAN_WINDOW];
-    let held = evaluated.windows(RUNNING_MEDIAN_WINDOW).find_map(|w| {
-        for (slot, p) in window.iter_mut().zip(w) {
-            *slot = p.val_rmse;
+    let vals: Vec<f64> = evaluated.iter().map(|p| p.val_rmse).collect();
+    let mut held = None;
+    for (window, end) in vals
+        .windows(RUNNING_MEDIAN_WINDOW)
+        .zip(evaluated.iter().skip(RUNNING_MEDIAN_WINDOW - 1))
+    {
+        let median = flapssm_analysis::stats::median(window).map_err(|e| JobError::Analysis {
+            what: "running median of the validation RMSE".into(),
+            source: e,
+        })?;
+        if median <= threshold {
+            held = Some(*end);
+            break;
         }
-        window.sort_by(f64::total_cmp);
-        (window[RUNNING_MEDIAN_WINDOW / 2] <= threshold).then(|| w[RUNNING_MEDIAN_WINDOW - 1])
-    });
+    }
     Ok(TimeToQuality {
         converged_rmse: converged,
         threshold,
         reached: evaluated.iter().copied().find(|p| p.val_rmse <= threshold),
         held,
         last,
-        best_rmse: run
-            .iter()
-            .map(|p| p.val_rmse)
-            .filter(|v| v.is_finite())
-            .fold(f64::INFINITY, f64::min),
+        best_rmse: vals.iter().copied().fold(f64::INFINITY, f64::min),
     })
 }
 
