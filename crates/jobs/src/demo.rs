@@ -93,7 +93,8 @@ pub struct DemoConfig {
 impl DemoConfig {
     /// The default (short) configuration: 192 trajectories (179 train, 13 test, the published
     /// split ratio) of 470 samples; PR-SSM D_x 8, M 32, 10 particles, minibatches of 4 whole
-    /// trajectories, Adam lr 0.05 decaying exponentially to 0.005, 1000 epochs (41 000 steps).
+    /// trajectories in 2 parallel tasks of 2 (two cores busy; one task of 4 left the second
+    /// idle), Adam lr 0.05 decaying exponentially to 0.005, 1000 epochs (41 000 steps).
     /// See docs/demo.md for its wall time.
     ///
     /// The wing is `flapssm simulate`'s default (L2, the same for every command; chosen on
@@ -116,6 +117,7 @@ impl DemoConfig {
                 particles: Some(10),
                 epochs: Some(1000),
                 batch: Some(4),
+                windows_per_task: Some(2),
                 lr: Some(0.05),
                 schedule: Some(LrSchedule::Exponential { final_factor: 0.1 }),
                 eval_every: Some(25),
@@ -711,6 +713,16 @@ mod tests {
     /// `--full --preset paper-fast` changes the training schedule only: the paper's model,
     /// 300 epochs of minibatches of 4 (38 400 steps), still all 512 fitted and the lowest
     /// training loss kept.
+    #[test]
+    fn the_default_demo_keeps_two_cores_busy() {
+        let plan = DemoConfig::default_for(0).training.check().unwrap();
+        let spec = plan.spec();
+        assert_eq!(spec.train.batch_size, 4);
+        assert_eq!(spec.windows_per_task, 2);
+        let tasks = spec.train.batch_size.div_ceil(spec.windows_per_task);
+        assert_eq!(tasks, 2);
+    }
+
     #[test]
     fn full_with_the_fast_preset_keeps_the_published_protocol() {
         let mut fast = DemoConfig::full(3);

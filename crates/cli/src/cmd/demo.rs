@@ -75,8 +75,9 @@ pub struct DemoArgs {
     #[arg(long)]
     precision: Option<Precision>,
     /// Windows (sequences) per parallel task of the ELBO: a minibatch of B windows keeps at
-    /// most ceil(B / N) threads busy (default 4: batch 16 fills 4 cores); results depend on the
-    /// thread count not at all, on N only in the last bits (docs/training.md).
+    /// most ceil(B / N) threads busy (default 2: the default's minibatches of 4 fill 2 cores;
+    /// with --full the preset's, 4 for batch 16); results depend on the thread count not at
+    /// all, on N only in the last bits (docs/training.md).
     #[arg(long, value_name = "N", value_parser = super::positive::<usize>)]
     windows_per_task: Option<usize>,
     /// Override the initial lengthscale of every GP input, in standardized units (published:
