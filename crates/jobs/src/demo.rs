@@ -93,8 +93,8 @@ pub struct DemoConfig {
 impl DemoConfig {
     /// The default (short) configuration: 192 trajectories (179 train, 13 test, the published
     /// split ratio) of 470 samples; PR-SSM D_x 8, M 32, 10 particles, minibatches of 4 whole
-    /// trajectories in 2 parallel tasks of 2 (two cores busy; one task of 4 left the second
-    /// idle), Adam lr 0.05 decaying exponentially to 0.005, 1000 epochs (41 000 steps).
+    /// trajectories in 2 parallel tasks of 2 (two cores busy), Adam lr 0.05 decaying
+    /// exponentially to 0.005, 1000 epochs (41 000 steps).
     /// See docs/demo.md for its wall time.
     ///
     /// The wing is `flapssm simulate`'s default (L2, the same for every command; chosen on
@@ -710,9 +710,8 @@ mod tests {
         assert!(default.val_fraction() > 0.0);
     }
 
-    /// `--full --preset paper-fast` changes the training schedule only: the paper's model,
-    /// 300 epochs of minibatches of 4 (38 400 steps), still all 512 fitted and the lowest
-    /// training loss kept.
+    /// The default demo's minibatches of 4 are 2 parallel tasks: both cores of a 2-core
+    /// machine train.
     #[test]
     fn the_default_demo_keeps_two_cores_busy() {
         let plan = DemoConfig::default_for(0).training.check().unwrap();
@@ -723,6 +722,9 @@ mod tests {
         assert_eq!(tasks, 2);
     }
 
+    /// `--full --preset paper-fast` changes the training schedule only: the paper's model,
+    /// 300 epochs of minibatches of 4 (38 400 steps), still all 512 fitted and the lowest
+    /// training loss kept.
     #[test]
     fn full_with_the_fast_preset_keeps_the_published_protocol() {
         let mut fast = DemoConfig::full(3);
