@@ -1,7 +1,8 @@
 """The Snakemake workflow on its tiny configuration: every rule runs (simulate, one sweep run per
 kind × value × seed and their merge; one demo per seed and their merge), the merged sweep table
 carries the paper's two selection rows with the spread over seeds, the merged demos one row per
-seed and the paper's rows per seed, a second invocation has nothing to do, and the Slurm
+seed and the paper's rows per seed, a second invocation has nothing to do, a lost result is
+rerun from its run's checkpoint, and the Slurm
 profile plans the same jobs (dry run; no cluster here). The paper's two configurations plan
 their 16 runs each (dry run), the fast one with the fast preset; the paper's experiment on three
 seeds plans three `demo --full --preset paper-fast` runs (a `true` option is a bare switch)."""
@@ -77,6 +78,20 @@ def test_tiny_workflow_runs_merges_and_resumes(tmp_path):
     again = snakemake("--profile", str(WORKFLOW / "profiles" / "local"), cwd=tmp_path)
     assert again.returncode == 0, again.stderr[-4000:]
     assert "Nothing to be done" in again.stdout + again.stderr
+
+    # A lost result (and the merge) reruns from its run's checkpoint (--resume), same errors.
+    result = tmp_path / "results" / "dx" / "dx6_seed1.json"
+    assert result.with_name("dx6_seed1.ckpt.json").exists()
+    before = json.loads(result.read_text())
+    result.unlink()
+    for merged in (tmp_path / "results").glob("selections.*"):
+        merged.unlink()
+    rerun = snakemake("--profile", str(WORKFLOW / "profiles" / "local"), cwd=tmp_path)
+    assert rerun.returncode == 0, rerun.stderr[-4000:]
+    after = json.loads(result.read_text())
+    assert after["resumed_at_step"] == before["steps"] == after["steps"]
+    assert after["test"] == before["test"]
+    assert "resuming dx = 6 at step" in (tmp_path / "logs" / "dx" / "dx6_seed1.log").read_text()
 
 
 def test_slurm_profile_plans_the_same_jobs(tmp_path):

@@ -175,30 +175,43 @@ fn tiny_demo_evaluate_and_sweep() {
     let mut results = Vec::new();
     for (kind, value) in [("dx", "6"), ("data-size", "4")] {
         let out = tmp.path().join(format!("sweep-{kind}.json"));
-        ok(&[
-            "sweep",
-            "run",
-            "--kind",
-            kind,
-            "--value",
-            value,
-            "--dataset",
-            ds.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-            "--epochs",
-            "2",
-            "--inducing",
-            "8",
-            "--particles",
-            "4",
-            "--eval-particles",
-            "4",
-        ]);
-        let r = json(&out);
+        let run = |extra: &[&str]| {
+            let mut args = vec![
+                "sweep",
+                "run",
+                "--kind",
+                kind,
+                "--value",
+                value,
+                "--dataset",
+                ds.to_str().unwrap(),
+                "--out",
+                out.to_str().unwrap(),
+                "--epochs",
+                "2",
+                "--inducing",
+                "8",
+                "--particles",
+                "4",
+                "--eval-particles",
+                "4",
+            ];
+            args.extend_from_slice(extra);
+            ok(&args);
+            json(&out)
+        };
+        // `--resume` without a checkpoint starts from the beginning.
+        let r = run(&["--resume"]);
         assert_eq!(r["kind"], kind);
+        assert!(r.get("resumed_at_step").is_none());
         let n_train = r["n_fit"].as_u64().unwrap() + r["n_val"].as_u64().unwrap();
         assert_eq!(n_train, if kind == "dx" { 7 } else { 4 });
+        // Its checkpoint lies beside the result; resuming the finished run adds no step and
+        // gives the same errors.
+        assert!(tmp.path().join(format!("sweep-{kind}.ckpt.json")).exists());
+        let again = run(&["--resume"]);
+        assert_eq!(again["resumed_at_step"], r["steps"]);
+        assert_eq!((&again["train"], &again["test"]), (&r["train"], &r["test"]));
         results.push(out);
     }
     let table = tmp.path().join("sweep.csv");

@@ -8,12 +8,12 @@
 //! standardized outputs (the dataset's full training statistics, so all configurations share
 //! one scale) from `start_sample` on, on the trajectories trained on and on the test set.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
-use flapssm_prssm::train::EpochRecord;
 use flapssm_prssm::train::fit::FitSpec;
+use flapssm_prssm::train::{Checkpoint, EpochRecord};
 use flapssm_wing::dataset::{OUTPUT_NAMES, Standardization, ValidDataset};
 use serde::{Deserialize, Serialize};
 
@@ -112,8 +112,12 @@ pub struct SweepResult {
     pub best_epoch: Option<u64>,
     /// Optimizer steps.
     pub steps: u64,
-    /// Training wall time (s).
+    /// Training wall time of the process that finished the run (s): the part after the resumed
+    /// step when it was resumed.
     pub train_wall_s: f64,
+    /// Optimizer step the run was resumed at (absent when it ran in one process).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub resumed_at_step: Option<u64>,
     /// Per-epoch history.
     pub history: Vec<EpochRecord>,
 }
@@ -205,14 +209,20 @@ impl SweepSettings {
     }
 }
 
-/// Trains and evaluates one configuration ([`SweepSettings`], checked against `ds`).
+/// Trains and evaluates one configuration ([`SweepSettings`], checked against `ds`),
+/// checkpointing to `checkpoint` (every `checkpoint_every` epochs of the training options, and
+/// when stopped) and continuing from `resume`, which must belong to this configuration and
+/// dataset; a resumed run trains as the uninterrupted one would.
 ///
 /// # Errors
-/// Training and prediction errors.
+/// Training and prediction errors; [`JobError::Interrupted`] when stopped (the checkpoint is
+/// written first); a `resume` of another configuration or dataset.
 pub fn sweep_run(
     ds: &ValidDataset,
     dataset_label: &str,
     plan: &SweepPlan,
+    checkpoint: Option<&Path>,
+    resume: Option<Checkpoint>,
     progress: &dyn Progress,
     stop: Option<&AtomicBool>,
 ) -> Result<SweepResult> {
@@ -230,8 +240,9 @@ pub fn sweep_run(
     let (fit_set, val_set) = plan.split(train)?;
     let (n_fit, n_val) = (fit_set.len(), val_set.len());
     progress.start(&format!("train {} = {value}", kind.name()), 0);
+    let resumed_at_step = resume.as_ref().map(|c| c.state.step);
     let t0 = Instant::now();
-    let out = train_prssm(train, plan, None, None, None, progress, stop)?;
+    let out = train_prssm(train, plan, checkpoint, resume, None, progress, stop)?;
     let train_wall_s = t0.elapsed().as_secs_f64();
     progress.finish("");
 
@@ -283,8 +294,14 @@ pub fn sweep_run(
         best_epoch: out.outcome.state.best.as_ref().map(|b| b.epoch),
         steps: out.outcome.state.step,
         train_wall_s,
+        resumed_at_step,
         history: out.outcome.state.history.clone(),
     })
+}
+
+/// The checkpoint of the run whose result file is `result`: `<stem>.ckpt.json` beside it.
+pub fn checkpoint_beside(result: &Path) -> PathBuf {
+    crate::train::sibling(result, ".ckpt.json")
 }
 
 /// Reads a sweep result file, checking its format tag and version.
@@ -326,8 +343,12 @@ pub struct SweepRow {
     pub test_overall: Option<f64>,
     /// Test RMSE per output, if any.
     pub test_rmse: Option<Vec<f64>>,
-    /// Training wall time (s).
+    /// Training wall time of the process that finished the run (s): the part after the resumed
+    /// step when it was resumed.
     pub train_wall_s: f64,
+    /// Optimizer step the run was resumed at (absent when it ran in one process).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub resumed_at_step: Option<u64>,
     /// The source file.
     pub source: String,
 }
@@ -370,6 +391,7 @@ impl SweepTable {
                 test_overall: r.test.as_ref().map(|t| t.overall),
                 test_rmse: r.test.as_ref().map(|t| t.rmse_standardized.clone()),
                 train_wall_s: r.train_wall_s,
+                resumed_at_step: r.resumed_at_step,
                 source: src.clone(),
             })
             .collect();
@@ -438,7 +460,7 @@ impl SweepTable {
         for n in OUTPUT_NAMES {
             s.push_str(&format!(",test_rmse_{n}"));
         }
-        s.push_str(",train_wall_s,source\n");
+        s.push_str(",train_wall_s,resumed_at_step,source\n");
         let opt = |v: Option<f64>| v.map_or(String::new(), |v| v.to_string());
         for r in &self.rows {
             s.push_str(&format!(
@@ -457,8 +479,9 @@ impl SweepTable {
                 ));
             }
             s.push_str(&format!(
-                ",{},{}\n",
+                ",{},{},{}\n",
                 r.train_wall_s,
+                r.resumed_at_step.map_or(String::new(), |s| s.to_string()),
                 r.source.replace(',', ";")
             ));
         }
@@ -529,6 +552,97 @@ impl SweepTable {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::progress::NoProgress;
+    use crate::test_data::tiny_dataset;
+    use flapssm_prssm::train::fit::Preset;
+    use std::sync::atomic::Ordering;
+
+    /// Sets `stop` once the training has taken `after` steps.
+    struct StopAfter<'a> {
+        after: u64,
+        stop: &'a AtomicBool,
+    }
+    impl Progress for StopAfter<'_> {
+        fn set(&self, pos: u64, _total: u64) {
+            if pos >= self.after {
+                self.stop.store(true, Ordering::SeqCst);
+            }
+        }
+    }
+
+    fn tiny_settings(dx: usize) -> SweepSettings {
+        SweepSettings {
+            kind: SweepKind::Dx,
+            value: dx,
+            training: TrainingOptions {
+                preset: Preset::PaperFast,
+                inducing: Some(8),
+                particles: Some(2),
+                epochs: Some(3),
+                batch: Some(2),
+                val_fraction: 0.25,
+                checkpoint_every: 1,
+                ..TrainingOptions::default()
+            },
+            particles: 3,
+            seed: 2,
+            start_sample: 93,
+        }
+    }
+
+    /// A run stopped mid-way and resumed from its checkpoint (here under a cosine-annealed
+    /// rate, which depends on the step) ends with the uninterrupted run's models and errors;
+    /// a checkpoint of another configuration is refused.
+    #[test]
+    fn a_stopped_run_resumes_to_the_uninterrupted_result() {
+        let ds = tiny_dataset();
+        let dir = tempfile::tempdir().unwrap();
+        let plan = tiny_settings(6).check(&ds).unwrap();
+        let whole = sweep_run(&ds, "tiny", &plan, None, None, &NoProgress, None).unwrap();
+
+        let ckpt = dir.path().join("dx6.ckpt.json");
+        let stop = AtomicBool::new(false);
+        let stopper = StopAfter {
+            after: 3,
+            stop: &stop,
+        };
+        let err = sweep_run(&ds, "tiny", &plan, Some(&ckpt), None, &stopper, Some(&stop));
+        assert!(
+            matches!(err, Err(JobError::Interrupted { step: 3, .. })),
+            "{err:?}"
+        );
+        let resume = Checkpoint::load(&ckpt).unwrap();
+        let resumed = sweep_run(
+            &ds,
+            "tiny",
+            &plan,
+            Some(&ckpt),
+            Some(resume),
+            &NoProgress,
+            None,
+        )
+        .unwrap();
+        assert_eq!(resumed.resumed_at_step, Some(3));
+        assert!(whole.steps > 3 && resumed.steps == whole.steps);
+        assert_eq!(resumed.history, whole.history);
+        assert_eq!((&resumed.train, &resumed.test), (&whole.train, &whole.test));
+
+        let other = tiny_settings(7).check(&ds).unwrap();
+        let err = sweep_run(
+            &ds,
+            "tiny",
+            &other,
+            None,
+            Some(Checkpoint::load(&ckpt).unwrap()),
+            &NoProgress,
+            None,
+        );
+        assert!(
+            err.as_ref()
+                .is_err_and(|e| e.to_string().contains("differs")),
+            "{err:?}"
+        );
+    }
 
     fn row(kind: SweepKind, value: usize, seed: u64, train: f64, test: f64) -> SweepRow {
         SweepRow {
@@ -540,6 +654,7 @@ mod tests {
             test_overall: Some(test),
             test_rmse: None,
             train_wall_s: 1.0,
+            resumed_at_step: None,
             source: format!("{value}-{seed}"),
         }
     }

@@ -474,7 +474,7 @@ impl TrainFiles {
 }
 
 /// `<dir>/<stem><suffix>` next to `path`.
-fn sibling(path: &Path, suffix: &str) -> PathBuf {
+pub(crate) fn sibling(path: &Path, suffix: &str) -> PathBuf {
     let stem = path
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())

@@ -7,8 +7,11 @@ use anyhow::Context;
 use clap::{Args, Subcommand};
 use flapssm_jobs::files::check_outputs;
 use flapssm_jobs::files::save_json;
-use flapssm_jobs::sweep::{SweepKind, SweepSettings, SweepTable, load_result, sweep_run};
+use flapssm_jobs::sweep::{
+    SweepKind, SweepSettings, SweepTable, checkpoint_beside, load_result, sweep_run,
+};
 use flapssm_jobs::train::TrainingOptions;
+use flapssm_prssm::train::Checkpoint;
 use flapssm_prssm::train::fit::Preset;
 use flapssm_wing::dataset::Dataset;
 
@@ -92,6 +95,16 @@ pub struct RunArgs {
     /// First analysed sample (0-based; published 93).
     #[arg(long, default_value_t = 93)]
     start_sample: usize,
+    /// Write the training's checkpoint (`<out stem>.ckpt.json` beside --out) every this many
+    /// epochs; it is also written when the run is stopped (Ctrl-C, SIGTERM). 0: only then.
+    #[arg(long, value_name = "EPOCHS", default_value_t = 10)]
+    checkpoint_every: u64,
+    /// Continue from the checkpoint beside --out when there is one (a run stopped by Ctrl-C,
+    /// SIGTERM or a scheduler's time limit goes on as if never stopped); start from the
+    /// beginning when there is none. A checkpoint of another configuration or dataset is an
+    /// error.
+    #[arg(long)]
+    resume: bool,
 }
 
 /// `flapssm sweep merge`.
@@ -114,7 +127,8 @@ pub fn run(cmd: SweepCommand) -> anyhow::Result<()> {
 }
 
 fn run_one(a: RunArgs) -> anyhow::Result<()> {
-    check_outputs(&[&a.out], &[&a.dataset])?;
+    let checkpoint = checkpoint_beside(&a.out);
+    check_outputs(&[&a.out, &checkpoint], &[&a.dataset])?;
     let ds = Dataset::load(&a.dataset)
         .with_context(|| format!("loading dataset {}", a.dataset.display()))?;
     let training = TrainingOptions {
@@ -137,7 +151,7 @@ fn run_one(a: RunArgs) -> anyhow::Result<()> {
         precision: a.precision,
         windows_per_task: a.windows_per_task,
         lengthscale_init: None,
-        checkpoint_every: 0,
+        checkpoint_every: a.checkpoint_every,
     };
     let plan = SweepSettings {
         kind: a.kind,
@@ -148,11 +162,27 @@ fn run_one(a: RunArgs) -> anyhow::Result<()> {
         start_sample: a.start_sample,
     }
     .check(&ds)?;
+    let resume = if a.resume && checkpoint.exists() {
+        let c = Checkpoint::load(&checkpoint)
+            .with_context(|| format!("resuming from {}", checkpoint.display()))?;
+        println!(
+            "resuming {} = {} at step {} from {}",
+            a.kind.name(),
+            a.value,
+            c.state.step,
+            checkpoint.display()
+        );
+        Some(c)
+    } else {
+        None
+    };
     let stop = stop_flag()?;
     let r = sweep_run(
         &ds,
         &a.dataset.display().to_string(),
         &plan,
+        Some(&checkpoint),
+        resume,
         &Bars::new(),
         Some(&stop),
     )
