@@ -2,10 +2,10 @@
 kind × value × seed and their merge; one demo per seed and their merge), the merged sweep table
 carries the paper's two selection rows with the spread over seeds, the merged demos one row per
 seed and the paper's rows per seed, a second invocation has nothing to do, a lost result is
-rerun from its run's checkpoint, and the Slurm
-profile plans the same jobs (dry run; no cluster here). The paper's two configurations plan
-their 16 runs each (dry run), the fast one with the fast preset; the paper's experiment on three
-seeds plans three `demo --full --preset paper-fast` runs (a `true` option is a bare switch)."""
+rerun from its run's checkpoint, and the Slurm profile plans the same jobs (dry run; no cluster
+here). The paper's two configurations plan their 14 runs each (dry run; the size curve's 512 is
+the dx 12 run), the fast one with the fast preset; the paper's experiment on three seeds plans
+three `demo --full --preset paper-fast` runs (a `true` option is a bare switch)."""
 
 import json
 import os
@@ -112,13 +112,13 @@ def test_slurm_profile_plans_the_same_jobs(tmp_path):
 
 
 @pytest.mark.parametrize("config,preset", [("paper.yaml", "paper"), ("paper-fast.yaml", "paper-fast")])
-def test_the_paper_configurations_plan_sixteen_runs(tmp_path, config, preset):
+def test_the_paper_configurations_plan_fourteen_runs(tmp_path, config, preset):
     r = snakemake("--dry-run", "--printshellcmds", "--cores", "2", cwd=tmp_path, config=config)
     assert r.returncode == 0, r.stderr[-4000:]
     out = r.stdout + r.stderr
-    assert_planned(out, [("simulate", 1), ("sweep_run", 16), ("merge", 1)])
+    assert_planned(out, [("simulate", 1), ("sweep_run", 14), ("merge", 1)])
     runs = [line for line in out.splitlines() if " sweep run " in line]
-    assert len(runs) == 16 and all(f"--preset {preset} " in line for line in runs), runs[:2]
+    assert len(runs) == 14 and all(f"--preset {preset} " in line for line in runs), runs[:2]
 
 
 def test_the_full_demo_on_three_seeds_plans_switches(tmp_path):

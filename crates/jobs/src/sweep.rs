@@ -326,6 +326,33 @@ pub fn load_result(path: &Path) -> Result<SweepResult> {
     })
 }
 
+/// The training-size curve's points on all training trajectories that a D_x run already is: a
+/// `dx` result with the fit specification (seed included) of a `data-size` result, trained on
+/// more trajectories than it and on all of them, is the same configuration as the `data-size`
+/// run on all of them, which then need not run (unless one did: its own result is kept).
+fn full_set_points(results: &[(String, SweepResult)]) -> Vec<SweepRow> {
+    let sizes: Vec<&SweepResult> = results
+        .iter()
+        .map(|(_, r)| r)
+        .filter(|r| r.kind == SweepKind::DataSize)
+        .collect();
+    results
+        .iter()
+        .filter(|(_, r)| r.kind == SweepKind::Dx)
+        .filter_map(|(src, r)| {
+            let all = r.n_fit + r.n_val;
+            let same = sizes.iter().any(|d| d.spec == r.spec && d.value < all);
+            let ran = sizes
+                .iter()
+                .any(|d| d.value == all && d.options.seed == r.options.seed);
+            (same && !ran).then(|| {
+                let source = format!("{src} (dx = {}: the same configuration)", r.value);
+                SweepRow::of(r, SweepKind::DataSize, all, source)
+            })
+        })
+        .collect()
+}
+
 /// One row of the merged table.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SweepRow {
@@ -353,6 +380,24 @@ pub struct SweepRow {
     pub source: String,
 }
 
+impl SweepRow {
+    /// The row of `r` as the point `kind = value`.
+    fn of(r: &SweepResult, kind: SweepKind, value: usize, source: String) -> Self {
+        Self {
+            kind,
+            value,
+            seed: r.options.seed,
+            n_train: r.n_fit + r.n_val,
+            train_overall: r.train.overall,
+            test_overall: r.test.as_ref().map(|t| t.overall),
+            test_rmse: r.test.as_ref().map(|t| t.rmse_standardized.clone()),
+            train_wall_s: r.train_wall_s,
+            resumed_at_step: r.resumed_at_step,
+            source,
+        }
+    }
+}
+
 /// Merged sweep results, sorted by kind, value and seed.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SweepTable {
@@ -368,7 +413,9 @@ pub struct SweepTable {
 }
 
 impl SweepTable {
-    /// Builds the table from `(source name, result)` pairs.
+    /// Builds the table from `(source name, result)` pairs. A D_x run with a training-size
+    /// run's fit specification, trained on all the training trajectories, is also the size
+    /// curve's point on all of them (the same configuration), unless that point was run.
     ///
     /// # Errors
     /// [`JobError::Mismatch`] for no results.
@@ -382,18 +429,8 @@ impl SweepTable {
         }
         let mut rows: Vec<SweepRow> = results
             .iter()
-            .map(|(src, r)| SweepRow {
-                kind: r.kind,
-                value: r.value,
-                seed: r.options.seed,
-                n_train: r.n_fit + r.n_val,
-                train_overall: r.train.overall,
-                test_overall: r.test.as_ref().map(|t| t.overall),
-                test_rmse: r.test.as_ref().map(|t| t.rmse_standardized.clone()),
-                train_wall_s: r.train_wall_s,
-                resumed_at_step: r.resumed_at_step,
-                source: src.clone(),
-            })
+            .map(|(src, r)| SweepRow::of(r, r.kind, r.value, src.clone()))
+            .chain(full_set_points(results))
             .collect();
         rows.sort_by_key(|a| (a.kind, a.value, a.seed));
         let mut table = Self {
@@ -657,6 +694,50 @@ mod tests {
             resumed_at_step: None,
             source: format!("{value}-{seed}"),
         }
+    }
+
+    /// A D_x run of the training-size runs' specification is also the size curve's point on
+    /// all training trajectories; a run of another D_x is not, and a point that was run keeps
+    /// its own result.
+    #[test]
+    fn a_dx_run_of_the_size_curves_configuration_is_its_full_set_point() {
+        let ds = tiny_dataset();
+        let run = |kind: SweepKind, value: usize, dx: Option<usize>| {
+            let mut settings = tiny_settings(value);
+            settings.kind = kind;
+            settings.training.dx = dx;
+            let plan = settings.check(&ds).unwrap();
+            sweep_run(&ds, "tiny", &plan, None, None, &NoProgress, None).unwrap()
+        };
+        let (dx6, dx7) = (run(SweepKind::Dx, 6, None), run(SweepKind::Dx, 7, None));
+        let size2 = run(SweepKind::DataSize, 2, Some(6));
+        let sizes = |results: &[&SweepResult]| {
+            let named: Vec<(String, SweepResult)> = results
+                .iter()
+                .enumerate()
+                .map(|(i, r)| (format!("r{i}"), (*r).clone()))
+                .collect();
+            let table = SweepTable::new(&named).unwrap();
+            table
+                .rows
+                .into_iter()
+                .filter(|r| r.kind == SweepKind::DataSize)
+                .map(|r| (r.value, r.source, r.test_overall))
+                .collect::<Vec<_>>()
+        };
+        let test = |r: &SweepResult| r.test.as_ref().map(|t| t.overall);
+        assert_eq!(
+            sizes(&[&dx6, &dx7, &size2]),
+            [
+                (2, "r2".to_string(), test(&size2)),
+                (4, "r0 (dx = 6: the same configuration)".into(), test(&dx6))
+            ]
+        );
+        let size4 = run(SweepKind::DataSize, 4, Some(6));
+        assert_eq!(test(&size4), test(&dx6));
+        let kept = sizes(&[&dx6, &size2, &size4]);
+        assert_eq!(kept.len(), 2);
+        assert_eq!((kept[1].0, kept[1].1.as_str()), (4, "r2"));
     }
 
     /// Mean and max − min over seeds per value; the paper's two rows carry them.
