@@ -12,8 +12,8 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
+use flapssm_prssm::train::EpochRecord;
 use flapssm_prssm::train::fit::FitSpec;
-use flapssm_prssm::train::{Checkpoint, EpochRecord};
 use flapssm_wing::dataset::{OUTPUT_NAMES, Standardization, ValidDataset};
 use serde::{Deserialize, Serialize};
 
@@ -23,7 +23,7 @@ use crate::files::save_json;
 use crate::paper_comparison::{ComparisonRow, SelectionPoint, selection_rows};
 use crate::predict::predict_prssm;
 use crate::progress::Progress;
-use crate::train::{TrainingOptions, TrainingPlan, train_prssm};
+use crate::train::{TrainingOptions, TrainingPlan, load_checkpoint, train_prssm};
 
 /// Format tag of a sweep result file.
 pub const RESULT_FORMAT: &str = "flapssm-sweep-result";
@@ -211,18 +211,19 @@ impl SweepSettings {
 
 /// Trains and evaluates one configuration ([`SweepSettings`], checked against `ds`),
 /// checkpointing to `checkpoint` (every `checkpoint_every` epochs of the training options, and
-/// when stopped) and continuing from `resume`, which must belong to this configuration and
-/// dataset; a resumed run trains as the uninterrupted one would.
+/// when stopped). With `resume`, a checkpoint already there is continued from (it must belong
+/// to this configuration and dataset; the run then trains as the uninterrupted one would);
+/// without one the run starts from the beginning.
 ///
 /// # Errors
 /// Training and prediction errors; [`JobError::Interrupted`] when stopped (the checkpoint is
-/// written first); a `resume` of another configuration or dataset.
+/// written first); an unreadable checkpoint, or one of another configuration or dataset.
 pub fn sweep_run(
     ds: &ValidDataset,
     dataset_label: &str,
     plan: &SweepPlan,
     checkpoint: Option<&Path>,
-    resume: Option<Checkpoint>,
+    resume: bool,
     progress: &dyn Progress,
     stop: Option<&AtomicBool>,
 ) -> Result<SweepResult> {
@@ -239,6 +240,19 @@ pub fn sweep_run(
     let train = &ds.trajectories[..used];
     let (fit_set, val_set) = plan.split(train)?;
     let (n_fit, n_val) = (fit_set.len(), val_set.len());
+    let resume = match checkpoint {
+        Some(path) if resume && path.exists() => {
+            let c = load_checkpoint(path)?;
+            progress.println(&format!(
+                "resuming {} = {value} at step {} from {}",
+                kind.name(),
+                c.state.step,
+                path.display()
+            ));
+            Some(c)
+        }
+        _ => None,
+    };
     progress.start(&format!("train {} = {value}", kind.name()), 0);
     let resumed_at_step = resume.as_ref().map(|c| c.state.step);
     let t0 = Instant::now();
@@ -327,9 +341,9 @@ pub fn load_result(path: &Path) -> Result<SweepResult> {
 }
 
 /// The training-size curve's points on all training trajectories that a D_x run already is: a
-/// `dx` result with the fit specification (seed included) of a `data-size` result, trained on
-/// more trajectories than it and on all of them, is the same configuration as the `data-size`
-/// run on all of them, which then need not run (unless one did: its own result is kept).
+/// `dx` result (trained on all of them) with the fit specification (seed included) of a
+/// `data-size` result is the same configuration as the `data-size` run on all of them, which
+/// then need not run (where one of that specification did, its own result is kept).
 fn full_set_points(results: &[(String, SweepResult)]) -> Vec<SweepRow> {
     let sizes: Vec<&SweepResult> = results
         .iter()
@@ -341,11 +355,8 @@ fn full_set_points(results: &[(String, SweepResult)]) -> Vec<SweepRow> {
         .filter(|(_, r)| r.kind == SweepKind::Dx)
         .filter_map(|(src, r)| {
             let all = r.n_fit + r.n_val;
-            let same = sizes.iter().any(|d| d.spec == r.spec && d.value < all);
-            let ran = sizes
-                .iter()
-                .any(|d| d.value == all && d.options.seed == r.options.seed);
-            (same && !ran).then(|| {
+            let same: Vec<_> = sizes.iter().filter(|d| d.spec == r.spec).collect();
+            (!same.is_empty() && same.iter().all(|d| d.value != all)).then(|| {
                 let source = format!("{src} (dx = {}: the same configuration)", r.value);
                 SweepRow::of(r, SweepKind::DataSize, all, source)
             })
@@ -635,7 +646,7 @@ mod tests {
         let ds = tiny_dataset();
         let dir = tempfile::tempdir().unwrap();
         let plan = tiny_settings(6).check(&ds).unwrap();
-        let whole = sweep_run(&ds, "tiny", &plan, None, None, &NoProgress, None).unwrap();
+        let whole = sweep_run(&ds, "tiny", &plan, None, false, &NoProgress, None).unwrap();
 
         let ckpt = dir.path().join("dx6.ckpt.json");
         let stop = AtomicBool::new(false);
@@ -643,37 +654,19 @@ mod tests {
             after: 3,
             stop: &stop,
         };
-        let err = sweep_run(&ds, "tiny", &plan, Some(&ckpt), None, &stopper, Some(&stop));
+        let err = sweep_run(&ds, "tiny", &plan, Some(&ckpt), true, &stopper, Some(&stop));
         assert!(
             matches!(err, Err(JobError::Interrupted { step: 3, .. })),
             "{err:?}"
         );
-        let resume = Checkpoint::load(&ckpt).unwrap();
-        let resumed = sweep_run(
-            &ds,
-            "tiny",
-            &plan,
-            Some(&ckpt),
-            Some(resume),
-            &NoProgress,
-            None,
-        )
-        .unwrap();
+        let resumed = sweep_run(&ds, "tiny", &plan, Some(&ckpt), true, &NoProgress, None).unwrap();
         assert_eq!(resumed.resumed_at_step, Some(3));
         assert!(whole.steps > 3 && resumed.steps == whole.steps);
         assert_eq!(resumed.history, whole.history);
         assert_eq!((&resumed.train, &resumed.test), (&whole.train, &whole.test));
 
         let other = tiny_settings(7).check(&ds).unwrap();
-        let err = sweep_run(
-            &ds,
-            "tiny",
-            &other,
-            None,
-            Some(Checkpoint::load(&ckpt).unwrap()),
-            &NoProgress,
-            None,
-        );
+        let err = sweep_run(&ds, "tiny", &other, Some(&ckpt), true, &NoProgress, None);
         assert!(
             err.as_ref()
                 .is_err_and(|e| e.to_string().contains("differs")),
@@ -707,7 +700,7 @@ mod tests {
             settings.kind = kind;
             settings.training.dx = dx;
             let plan = settings.check(&ds).unwrap();
-            sweep_run(&ds, "tiny", &plan, None, None, &NoProgress, None).unwrap()
+            sweep_run(&ds, "tiny", &plan, None, false, &NoProgress, None).unwrap()
         };
         let (dx6, dx7) = (run(SweepKind::Dx, 6, None), run(SweepKind::Dx, 7, None));
         let size2 = run(SweepKind::DataSize, 2, Some(6));

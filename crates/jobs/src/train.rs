@@ -447,6 +447,18 @@ fn budget_text(budget: &Budget) -> String {
     }
 }
 
+/// Reads the checkpoint at `path` to resume a run from.
+///
+/// # Errors
+/// [`JobError::Io`] naming the file, with the checkpoint's own error (missing, invalid JSON,
+/// another format version).
+pub(crate) fn load_checkpoint(path: &Path) -> Result<Checkpoint> {
+    Checkpoint::load(path).map_err(|e| JobError::Io {
+        path: path.to_path_buf(),
+        source: std::io::Error::other(format!("resuming: {e}")),
+    })
+}
+
 /// The files of a training run: the best model, the last model and the checkpoint.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TrainFiles {
@@ -512,12 +524,7 @@ pub fn train_dataset(
         return Err(flapssm_wing::dataset::DatasetError::NoOutputs.into());
     }
     let resume = if resume {
-        Some(
-            Checkpoint::load(&files.checkpoint).map_err(|e| JobError::Io {
-                path: files.checkpoint.clone(),
-                source: std::io::Error::other(format!("resuming: {e}")),
-            })?,
-        )
+        Some(load_checkpoint(&files.checkpoint)?)
     } else {
         None
     };

@@ -11,7 +11,6 @@ use flapssm_jobs::sweep::{
     SweepKind, SweepSettings, SweepTable, checkpoint_beside, load_result, sweep_run,
 };
 use flapssm_jobs::train::TrainingOptions;
-use flapssm_prssm::train::Checkpoint;
 use flapssm_prssm::train::fit::Preset;
 use flapssm_wing::dataset::Dataset;
 
@@ -162,27 +161,13 @@ fn run_one(a: RunArgs) -> anyhow::Result<()> {
         start_sample: a.start_sample,
     }
     .check(&ds)?;
-    let resume = if a.resume && checkpoint.exists() {
-        let c = Checkpoint::load(&checkpoint)
-            .with_context(|| format!("resuming from {}", checkpoint.display()))?;
-        println!(
-            "resuming {} = {} at step {} from {}",
-            a.kind.name(),
-            a.value,
-            c.state.step,
-            checkpoint.display()
-        );
-        Some(c)
-    } else {
-        None
-    };
     let stop = stop_flag()?;
     let r = sweep_run(
         &ds,
         &a.dataset.display().to_string(),
         &plan,
         Some(&checkpoint),
-        resume,
+        a.resume,
         &Bars::new(),
         Some(&stop),
     )
