@@ -37,6 +37,7 @@ fn section_kinematics(t: f64, r: f64) -> SectionKinematics {
         chord_velocity_rate_m_s2: r * (k.a[1] - k.omega_rad_s[2] * k.v_x),
         rotation_rate_rad_s: k.omega_rad_s[2],
         rotation_acc_rad_s2: k.omega_dot_rad_s2[2],
+        up_section: k.up_wing.map(|u| [u[0], u[1]]),
     }
 }
 

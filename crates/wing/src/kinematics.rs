@@ -78,6 +78,9 @@ pub struct WingKinematics {
     pub pitch_rate_rad_s: f64,
     /// Pitch acceleration α̈ (rad/s²), the Euler acceleration.
     pub pitch_acc_rad_s2: f64,
+    /// The global vertical y_0 (up, the stroke axis) in wing-frame components (a unit vector);
+    /// `None` where the orientation is not known ([`Self::from_omega`], [`Self::from_rotation`]).
+    pub up_wing: Option<[f64; 3]>,
 }
 
 /// A 3×3 matrix, rows first.
@@ -105,7 +108,11 @@ impl WingKinematics {
                 + psi_d * c_al * alpha_d,
             phi_dd * s_psi + phi_d * psi_d * c_psi + alpha_dd,
         ];
-        Self::from_omega(omega, omega_dot, alpha_d, alpha_dd)
+        let r = rotation_global_from_wing(&state.angles_rad);
+        Self {
+            up_wing: Some(r[1]),
+            ..Self::from_omega(omega, omega_dot, alpha_d, alpha_dd)
+        }
     }
 
     /// Wing kinematics from the wing-frame angular velocity ω and its derivative ω̇, plus the
@@ -131,6 +138,7 @@ impl WingKinematics {
             a,
             pitch_rate_rad_s,
             pitch_acc_rad_s2,
+            up_wing: None,
         }
     }
 

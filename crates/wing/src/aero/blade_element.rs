@@ -203,6 +203,7 @@ impl BladeElement {
                 chord_velocity_rate_m_s2: r * t_rate,
                 rotation_rate_rad_s: wz,
                 rotation_acc_rad_s2: wz_dot,
+                up_section: kin.up_wing.map(|u| [u[0], u[1]]),
             };
             let l = model.step(&section, dt_s);
             let arm = r - self.geom.sensor_radius_m;

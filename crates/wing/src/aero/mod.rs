@@ -54,6 +54,9 @@ pub struct SectionKinematics {
     pub rotation_rate_rad_s: f64,
     /// ω̇_z (rad/s²).
     pub rotation_acc_rad_s2: f64,
+    /// The global vertical (up) in section components [x_w, y_w] (not normalized: its part
+    /// along the span is left out); `None` where the wing's orientation is not known.
+    pub up_section: Option<[f64; 2]>,
 }
 
 impl SectionKinematics {

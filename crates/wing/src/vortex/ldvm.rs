@@ -3,7 +3,7 @@
 use std::f64::consts::PI;
 
 use super::wake::{LANES, PlateFrame, Wake, induced_at};
-use super::{LdvmParams, MergeParams, VortexError, VortexKind};
+use super::{LdvmParams, MergeParams, VortexError, VortexKind, WakeMotion};
 
 /// Pose and velocity of the plate in the inertial plane.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -423,8 +423,12 @@ impl Ldvm {
             eps4: (4.0 * self.p.core_radius_frac).powi(2),
             b: &self.b,
         };
-        self.wake
-            .compute_velocities(|x, z, u, w| sheet.velocities_at(x, z, u, w));
+        match self.p.wake_motion {
+            WakeMotion::Free => self
+                .wake
+                .compute_velocities(|x, z, u, w| sheet.velocities_at(x, z, u, w)),
+            WakeMotion::Frozen => self.wake.hold_still(),
+        }
         self.diag = LdvmDiagnostics {
             lesp: b0 / self.u_ref_m_s,
             lesp_unshed: lesp0,

@@ -141,6 +141,21 @@ impl Default for MergeParams {
     }
 }
 
+/// How the free vortices move.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum WakeMotion {
+    /// Free vortex dynamics: every free vortex moves with the velocity induced by the other
+    /// free vortices and the bound sheet (Ramesh et al.'s LDVM).
+    #[default]
+    Free,
+    /// A frozen wake: free vortices stay where they were shed, in the frame of the fluid at rest
+    /// far away (the planar wake of Wagner's and Theodorsen's theories, which the plate leaves
+    /// behind). They still decay, grow their cores, are deleted far away and amalgamated. No
+    /// vortex-on-vortex induction, so the wake has no dynamics of its own.
+    Frozen,
+}
+
 /// Parameters of the 2-D LDVM (unchecked; [`Ldvm::new`] validates them once).
 ///
 /// | field | default | meaning |
@@ -160,6 +175,7 @@ impl Default for MergeParams {
 /// | `far_field_chords` | Some(12.0) | free vortices farther than this from the pivot are deleted |
 /// | `merge` | Some(default) | Spalart amalgamation, see [`MergeParams`] |
 /// | `max_vortices` | 110 | hard cap on free vortices (storage is allocated once) |
+/// | `wake_motion` | `Free` | free vortex dynamics or a frozen wake, see [`WakeMotion`] |
 ///
 /// LESP_crit: Ramesh et al. report 0.1–0.2 for Re 10³–10⁴; UNSflow uses 0.11 for a flat plate in
 /// the Eldredge pitch-up. The default 0.15 sits in the middle; 2-D models shed the LEV too readily
@@ -208,6 +224,9 @@ pub struct LdvmParams {
     pub merge: Option<MergeParams>,
     /// Hard cap on the number of free vortices.
     pub max_vortices: usize,
+    /// How the free vortices move.
+    #[serde(default)]
+    pub wake_motion: WakeMotion,
 }
 
 impl Default for LdvmParams {
@@ -228,6 +247,7 @@ impl Default for LdvmParams {
             far_field_chords: Some(12.0),
             merge: Some(MergeParams::default()),
             max_vortices: 110,
+            wake_motion: WakeMotion::Free,
         }
     }
 }

@@ -320,6 +320,13 @@ impl Wake {
         }
     }
 
+    /// Sets every vortex's velocity to zero (a frozen wake).
+    pub(crate) fn hold_still(&mut self) {
+        let n = self.len();
+        self.u[..n].fill(0.0);
+        self.w[..n].fill(0.0);
+    }
+
     /// Moves every vortex by its stored velocity times `dt_s` (forward Euler). A vortex that
     /// would pass through the plate (its normal coordinate changes sign between the plate pose
     /// `before` and `after` while its chord coordinate stays within [0, c]) is mirrored back to
