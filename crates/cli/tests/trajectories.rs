@@ -151,3 +151,48 @@ fn simulate_drives_the_wing_with_the_papers_trajectories() {
     ]);
     assert_fails(&o, &["setting n = 549", "548"], &bad);
 }
+
+#[test]
+fn simulate_takes_the_l2_wake_model_and_refuses_unknown_names() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("w.npz");
+    ok(&[
+        "simulate",
+        "--source",
+        "paper",
+        "--n",
+        "2",
+        "--wake",
+        "frozen",
+        "--inflow",
+        "momentum",
+        "--noise-free",
+        "--quiet",
+        "--out",
+        s(&out),
+    ]);
+    let ds = Dataset::load(&out).unwrap();
+    let settings = ds.meta.settings.to_string();
+    assert!(settings.contains(r#""wake_motion":"frozen""#), "{settings}");
+    assert!(settings.contains(r#""inflow":"momentum""#), "{settings}");
+    assert!(ds.trajectories.iter().all(|t| {
+        t.outputs
+            .as_ref()
+            .unwrap()
+            .iter()
+            .flatten()
+            .all(|v| v.is_finite())
+    }));
+    let bad = dir.path().join("b.npz");
+    for (flag, value, said) in [
+        (
+            "--wake",
+            "swirling",
+            "unknown wake motion `swirling` (expected free or frozen)",
+        ),
+        ("--inflow", "uniform:-1", "unknown inflow `uniform:-1`"),
+    ] {
+        let o = flapssm(&["simulate", "--n", "2", flag, value, "--out", s(&bad)]);
+        assert_fails(&o, &[flag, said], &bad);
+    }
+}

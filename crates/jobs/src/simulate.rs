@@ -11,6 +11,7 @@ use flapssm_wing::trajectories::{GeneratorConfig, default_n_train};
 use flapssm_wing::virtual_wing::{
     Fidelity, SimulationConfig, VirtualWingConfig, simulate_angles_dataset, simulate_dataset,
 };
+use flapssm_wing::vortex::{Inflow, WakeMotion};
 
 use crate::error::{JobError, Result};
 use crate::progress::Progress;
@@ -30,6 +31,10 @@ pub struct SimulateSettings {
     pub noise_free: bool,
     /// No stroke deviation (planar strokes).
     pub flat: bool,
+    /// How the L2 strips' free vortices move.
+    pub wake_motion: WakeMotion,
+    /// The L2 strips' induced inflow.
+    pub inflow: Inflow,
 }
 
 impl Default for SimulateSettings {
@@ -42,6 +47,8 @@ impl Default for SimulateSettings {
             fidelity: VirtualWingConfig::default().fidelity,
             noise_free: false,
             flat: false,
+            wake_motion: WakeMotion::default(),
+            inflow: Inflow::default(),
         }
     }
 }
@@ -78,18 +85,18 @@ impl SimulateSettings {
             trajectories.max_deviation_deg = 0.0;
         }
         crate::resources::check_dataset("n", n, trajectories.sampling.n_samples)?;
-        Ok(SimulationConfig {
-            wing: VirtualWingConfig {
-                fidelity: self.fidelity,
-                sensor: if self.noise_free {
-                    SensorConfig::noise_free()
-                } else {
-                    SensorConfig::default()
-                },
-                ..VirtualWingConfig::default()
+        let mut wing = VirtualWingConfig {
+            fidelity: self.fidelity,
+            sensor: if self.noise_free {
+                SensorConfig::noise_free()
+            } else {
+                SensorConfig::default()
             },
-            trajectories,
-        })
+            ..VirtualWingConfig::default()
+        };
+        wing.l2.ldvm.wake_motion = self.wake_motion;
+        wing.l2.inflow = self.inflow;
+        Ok(SimulationConfig { wing, trajectories })
     }
 }
 

@@ -237,6 +237,7 @@ pub fn simulate(
         fidelity,
         noise_free,
         flat,
+        ..SimulateSettings::default()
     }
     .check()
     .map_err(|e| job_error(e, None))?;
@@ -356,6 +357,7 @@ pub fn simulate_angles(
         fidelity,
         noise_free,
         flat: false,
+        ..SimulateSettings::default()
     };
     let bar = PyProgress::new(progress);
     let ds = py.detach(|| {

@@ -13,7 +13,7 @@ use flapssm_wing::aero::quasi_steady::{
 use flapssm_wing::aero::unsteady::{UnsteadyParams, UnsteadySection};
 use flapssm_wing::aero::{SectionGeometry, SectionKinematics, SectionModel, SectionModelFactory};
 use flapssm_wing::kinematics::{EulerState, WingKinematics};
-use flapssm_wing::vortex::WakeMotion;
+use flapssm_wing::vortex::{Inflow, WakeMotion};
 use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, PI};
 
 fn section() -> SectionGeometry {
@@ -476,7 +476,7 @@ fn hovering_sanity() {
 #[test]
 fn hovering_figure_eight_sanity() {
     for fidelity in [Fidelity::L0, Fidelity::L1, Fidelity::L2] {
-        let hover = figure_eight_hover(&mut wing(fidelity));
+        let hover = figure_eight_hover(&mut wing(fidelity), 15.0);
         for (i, y) in hover.loads.iter().enumerate().skip(PER_CYCLE_8) {
             assert_in_dataset_ranges(y, hover.q_s, fidelity, i);
         }
@@ -491,7 +491,8 @@ fn hovering_figure_eight_sanity() {
 
 const PER_CYCLE_8: usize = 500;
 
-/// The figure-of-eight hover of `hovering_figure_eight_sanity` (0.3 Hz, 8 cycles) through `wing`.
+/// The figure-of-eight hover of `hovering_figure_eight_sanity` (0.3 Hz, 8 cycles, deviation
+/// amplitude `deviation_deg`; 0 is the flat Robofly stroke) through `wing`.
 struct FigureEightHover {
     /// Noise-free loads per sample.
     loads: Vec<[f64; 5]>,
@@ -501,11 +502,11 @@ struct FigureEightHover {
     mean_cl: Vec<f64>,
 }
 
-fn figure_eight_hover(wing: &mut VirtualWing) -> FigureEightHover {
+fn figure_eight_hover(wing: &mut VirtualWing, deviation_deg: f64) -> FigureEightHover {
     let (f, per_cycle, cycles) = (0.3, PER_CYCLE_8, 8);
     let dt = 1.0 / f / per_cycle as f64;
     let states: Vec<EulerState> = (0..cycles * per_cycle)
-        .map(|i| figure_eight_hover_state(i as f64 * dt, f, 15f64.to_radians()))
+        .map(|i| figure_eight_hover_state(i as f64 * dt, f, deviation_deg.to_radians()))
         .collect();
     let u_ref = 0.235
         * states[..per_cycle]
@@ -1021,31 +1022,39 @@ fn l2_frozen_wake_is_not_chaotic() {
 }
 
 /// The wake models of docs/vortex-method.md (round 12) side by side: the free wake (default), a
-/// frozen wake, and a frozen wake carried down by an induced inflow w = k·U_ref. Prints the
-/// figure-of-eight hover's mean C_L, the r_c0 × 1.001 change, the repeatability in the 2nd and
+/// frozen wake, and a frozen wake carried down by an induced inflow (w = k·U_ref, or from momentum
+/// theory). Prints the mean C_L of the flat-stroke and the figure-of-eight hover (cycles 2–8),
+/// the r_c0 × 1.001 change, the repeatability in the 2nd and
 /// 3rd cycles and the bursts. A study, not a check: `cargo test --release -p flapssm-wing --test
-/// physics l2_wake_motion_study -- --ignored --nocapture` (≈ 6 min on 2 cores).
+/// physics l2_wake_motion_study -- --ignored --nocapture` (≈ 8 min on 2 cores).
 #[test]
 #[ignore = "study: the free and the frozen wake on the three criteria"]
 fn l2_wake_motion_study() {
+    let uniform = |ratio| Inflow::Uniform { ratio };
     let variants = [
-        ("free", WakeMotion::Free, None),
-        ("frozen", WakeMotion::Frozen, None),
-        ("frozen, k 0.1", WakeMotion::Frozen, Some(0.1)),
-        ("frozen, k 0.2", WakeMotion::Frozen, Some(0.2)),
-        ("frozen, k 0.26", WakeMotion::Frozen, Some(0.26)),
+        ("free", WakeMotion::Free, Inflow::Still),
+        ("frozen", WakeMotion::Frozen, Inflow::Still),
+        ("frozen, k 0.1", WakeMotion::Frozen, uniform(0.1)),
+        ("frozen, k 0.2", WakeMotion::Frozen, uniform(0.2)),
+        ("frozen, k 0.26", WakeMotion::Frozen, uniform(0.26)),
+        ("frozen, momentum", WakeMotion::Frozen, Inflow::Momentum),
+        ("free, momentum", WakeMotion::Free, Inflow::Momentum),
     ];
-    for (name, motion, k) in variants {
+    for (name, motion, inflow) in variants {
         let mut cfg = l2_config();
         cfg.l2.ldvm.wake_motion = motion;
-        cfg.l2.inflow_ratio = k;
-        let cl = figure_eight_hover(&mut VirtualWing::new(&cfg).unwrap()).mean_cl;
-        let cl_mean = cl.iter().sum::<f64>() / cl.len() as f64;
+        cfg.l2.inflow = inflow;
+        let cl = |deviation_deg| {
+            let cl =
+                figure_eight_hover(&mut VirtualWing::new(&cfg).unwrap(), deviation_deg).mean_cl;
+            cl.iter().sum::<f64>() / cl.len() as f64
+        };
+        let (cl_flat, cl_mean) = (cl(0.0), cl(15.0));
         let [d, p] = l2_sensitivity(&cfg);
         let rep = repeatability(&cfg, 12);
         let bursts = l2_bursts(&cfg, false);
         println!(
-            "{name}: figure-of-eight C_L {cl_mean:.3}; r_c0 × 1.001 default {d:.3?} paper {p:.3?}; \
+            "{name}: C_L flat stroke {cl_flat:.3}, figure-of-eight {cl_mean:.3}; r_c0 × 1.001 default {d:.3?} paper {p:.3?}; \
              two histories, 2nd cycle {:.3?} 3rd {:.3?}; bursts {bursts:?}",
             rep[1], rep[2]
         );

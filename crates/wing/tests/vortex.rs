@@ -687,7 +687,7 @@ use flapssm_wing::aero::blade_element::BladeElement;
 use flapssm_wing::aero::quasi_steady::{QuasiSteadyParams, QuasiSteadySection};
 use flapssm_wing::aero::{SectionGeometry, SectionKinematics, SectionModel};
 use flapssm_wing::kinematics::{EulerState, WingKinematics};
-use flapssm_wing::vortex::{StripLdvm, StripLdvmFactory, StripLdvmParams, WakeMotion};
+use flapssm_wing::vortex::{Inflow, StripLdvm, StripLdvmFactory, StripLdvmParams, WakeMotion};
 
 /// Runs the L2 blade element (`n_strips` strips) over `states` sampled every `dt`.
 fn run_blade(states: &[EulerState], dt: f64, n_strips: usize) -> Vec<[f64; 5]> {
@@ -1423,7 +1423,7 @@ fn strip_inflow_equals_the_plate_rising_through_still_fluid() {
     // horizontal plate (normal x_w up), LE first
     let sinking = run(
         StripLdvmParams {
-            inflow_ratio: Some(k),
+            inflow: Inflow::Uniform { ratio: k },
             ..params
         },
         SectionKinematics {

@@ -40,6 +40,14 @@ pub struct SimulateArgs {
     /// Flat stroke plane: no deviation (ψ = 0).
     #[arg(long)]
     flat: bool,
+    /// L2 wake: free (vortex dynamics, the default) or frozen (vortices stay where shed, in
+    /// the moving fluid; docs/vortex-method.md, round 12).
+    #[arg(long, value_name = "MOTION", default_value = "free")]
+    wake: String,
+    /// L2 induced inflow: still (the default), momentum (blade-element momentum theory from
+    /// each strip's recent lift) or uniform:K (the fluid sinks at K·U_ref).
+    #[arg(long, value_name = "INFLOW", default_value = "still")]
+    inflow: String,
     /// Hide the progress bar.
     #[arg(long)]
     quiet: bool,
@@ -57,6 +65,8 @@ pub fn run(args: SimulateArgs) -> anyhow::Result<()> {
         fidelity,
         noise_free: args.noise_free,
         flat: args.flat,
+        wake_motion: args.wake.parse().context("parsing --wake")?,
+        inflow: args.inflow.parse().context("parsing --inflow")?,
     };
     let cfg = settings.check()?;
     let bars = Bars::new();

@@ -62,10 +62,12 @@
 //! integrator places one LDVM per strip; see [`strip`] for the section frame, the reference speed
 //! and the 3-D correction.
 
+mod inflow;
 mod ldvm;
 pub mod strip;
 mod wake;
 
+pub use inflow::Inflow;
 pub use ldvm::{Ldvm, LdvmDiagnostics, PlateState, SectionLoads};
 pub use strip::{StripLdvm, StripLdvmFactory, StripLdvmParams};
 pub use wake::{VortexKind, Wake};
@@ -95,6 +97,16 @@ pub enum VortexError {
         field: &'static str,
         /// Offending value.
         value: f64,
+    },
+    /// A setting's name is not one of its choices.
+    #[error("unknown {setting} `{name}` (expected {expected})")]
+    UnknownChoice {
+        /// The setting.
+        setting: &'static str,
+        /// The name given.
+        name: String,
+        /// The choices.
+        expected: &'static str,
     },
     /// The shedding system (Kelvin + LESP) is singular.
     #[error("vortex method step {step}: shedding system is singular (determinant {det})")]
@@ -154,6 +166,22 @@ pub enum WakeMotion {
     /// behind). They still decay, grow their cores, are deleted far away and amalgamated. No
     /// vortex-on-vortex induction, so the wake has no dynamics of its own.
     Frozen,
+}
+
+impl std::str::FromStr for WakeMotion {
+    type Err = VortexError;
+    /// `free` or `frozen`.
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s.to_ascii_lowercase().as_str() {
+            "free" => Ok(Self::Free),
+            "frozen" => Ok(Self::Frozen),
+            _ => Err(VortexError::UnknownChoice {
+                setting: "wake motion",
+                name: s.into(),
+                expected: "free or frozen",
+            }),
+        }
+    }
 }
 
 /// Parameters of the 2-D LDVM (unchecked; [`Ldvm::new`] validates them once).

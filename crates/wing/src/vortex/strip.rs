@@ -54,17 +54,18 @@
 //!
 //! # Induced inflow
 //!
-//! A hovering wing pushes the fluid down. With `inflow_ratio` = k the strip sits in fluid that
-//! moves straight down at w = k·U_ref (U_ref as above, so time scaling still holds): the
-//! vertical (the global y_0, from [`SectionKinematics::up_section`]) projected on the strip's
-//! plane gives the direction, and the strip works in the frame of that moving fluid — the plate
-//! rises through it at w on top of its own motion, and the vortices it sheds stay with the fluid.
-//! With a frozen wake ([`super::WakeMotion::Frozen`]) the wake is thus carried straight down at w
-//! without dynamics of its own. Momentum theory over the swept area gives w ≈ 0.23–0.34 U at the
-//! strips of the default wing at C_L 1.6 and the measured median stroke of 128° (w = √(L′/(2ρΦr)),
-//! L′ the lift per span, Φ the stroke amplitude, rad);
-//! `None` (the default) leaves the fluid at rest. Sections that do not know which way is up
-//! (`up_section: None`) get no inflow.
+//! A hovering wing pushes the fluid down. With `inflow` ([`Inflow`]) other than `Still` the
+//! strip sits in fluid that moves straight down at w: the vertical (the global y_0, from
+//! [`SectionKinematics::up_section`]) projected on the strip's plane gives the direction, and the
+//! strip works in the frame of that moving fluid — the plate rises through it at w on top of its
+//! own motion, and the vortices it sheds stay with the fluid. With a frozen wake
+//! ([`super::WakeMotion::Frozen`]) the wake is thus carried straight down at w without dynamics
+//! of its own. `Inflow::Momentum` takes w from blade-element momentum theory and the strip's own
+//! recent lift (module `inflow`); `Inflow::Uniform { ratio }` sets w = ratio·U_ref. Momentum
+//! theory at C_L 1.6 and the measured median stroke of 128° gives w ≈ 0.23–0.34 U at the two
+//! strips of the default wing. Sections that do not know which way is up (`up_section: None`)
+//! get no inflow. With an inflow the profile drag uses the velocity relative to the moving fluid.
+//! The options are under study, not the default (docs/vortex-method.md, round 12).
 //!
 //! # Profile drag
 //!
@@ -78,7 +79,8 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::{Ldvm, LdvmParams, PlateState, VortexError};
+use super::inflow::InflowState;
+use super::{Inflow, Ldvm, LdvmParams, PlateState, VortexError};
 use crate::aero::quasi_steady::{QuasiSteadyParams, translational_coefficients};
 use crate::aero::{
     SectionGeometry, SectionKinematics, SectionLoads, SectionModel, SectionModelFactory,
@@ -111,10 +113,9 @@ pub struct StripLdvmParams {
     /// Travel s_U (chords) over which the LESP reference speed averages, exponentially weighted
     /// (default 4); `None`: the mean speed since the start (module docs, "Reference speed").
     pub reference_speed_chords: Option<f64>,
-    /// Induced inflow w = k·U_ref (m/s, U_ref the reference speed above): the fluid around the
-    /// strip moves straight down at w, so the plate sees it and the wake is carried away with it
-    /// (module docs, "Induced inflow"); `None` (default) = still fluid.
-    pub inflow_ratio: Option<f64>,
+    /// The fluid's vertical motion around the strip (module docs, "Induced inflow"; default
+    /// [`Inflow::Still`]).
+    pub inflow: Inflow,
 }
 
 impl StripLdvmParams {
@@ -150,12 +151,12 @@ impl StripLdvmParams {
                 reason: "must be finite and > 0",
             });
         }
-        if let Some(k) = self.inflow_ratio
-            && !(k.is_finite() && k >= 0.0)
+        if let Inflow::Uniform { ratio } = self.inflow
+            && !(ratio.is_finite() && ratio >= 0.0)
         {
             return Err(VortexError::InvalidParameter {
-                name: "inflow_ratio",
-                value: k,
+                name: "inflow ratio",
+                value: ratio,
                 reason: "must be finite and >= 0",
             });
         }
@@ -191,7 +192,7 @@ impl Default for StripLdvmParams {
             max_substeps: 8,
             profile_drag: zero_incidence_drag(),
             reference_speed_chords: Some(4.0),
-            inflow_ratio: None,
+            inflow: Inflow::Still,
         }
     }
 }
@@ -220,7 +221,9 @@ pub struct StripLdvm {
     max_substeps: usize,
     /// s_U·c (m), or infinite (mean since the start).
     reference_travel_m: f64,
-    inflow_ratio: Option<f64>,
+    inflow: InflowState,
+    /// Loads of the last sub-step (for the inflow's lift).
+    last_loads: SectionLoads,
     prev_kin: SectionKinematics,
     plate: PlateState,
     started: bool,
@@ -245,7 +248,8 @@ impl StripLdvm {
             reference_travel_m: params
                 .reference_speed_chords
                 .map_or(f64::INFINITY, |s_u| s_u * section.chord_m),
-            inflow_ratio: params.inflow_ratio,
+            inflow: InflowState::new(params.inflow, section.density_kg_m3, section.chord_m),
+            last_loads: SectionLoads::default(),
             prev_kin: SectionKinematics::default(),
             plate: PlateState::default(),
             started: false,
@@ -301,6 +305,8 @@ impl SectionModel for StripLdvm {
         self.recent_travel_m = 0.0;
         self.prev_speed_m_s = 0.0;
         self.prev_kin = SectionKinematics::default();
+        self.inflow.reset();
+        self.last_loads = SectionLoads::default();
     }
 
     fn step(&mut self, kin: &SectionKinematics, dt_s: f64) -> SectionLoads {
@@ -366,6 +372,11 @@ impl StripLdvm {
         let ldvm = self.ldvm.as_mut()?;
         let speed = kin.speed_m_s();
         let omega = kin.rotation_rate_rad_s;
+        // the vertical in section components [x_w, y_w], normalized in the strip's plane
+        let up = kin.up_section.and_then(|[ux, uy]| {
+            let norm = ux.hypot(uy);
+            (norm > 1e-9).then(|| [ux / norm, uy / norm])
+        });
         // The first step starts impulsively; its dt sets the first TEV position and the
         // impulse of the start. Without a given interval it is the time of one step of travel
         // (`max_step_chords`), which keeps the run invariant under time scaling.
@@ -381,13 +392,35 @@ impl StripLdvm {
             let keep = (-ds / self.reference_travel_m).exp();
             self.recent_time_s = keep * self.recent_time_s + dt;
             self.recent_travel_m = keep * self.recent_travel_m + ds;
+            if let Some(up) = up
+                && !self.inflow.is_still()
+            {
+                let l = &self.last_loads;
+                let lift = l.normal_n_m * up[0] + l.chordwise_n_m * up[1];
+                let horizontal = kin.normal_velocity_m_s * up[1] - kin.chord_velocity_m_s * up[0];
+                self.inflow.advance(keep, dt, lift, horizontal);
+            }
         }
         let u_ref = if self.recent_time_s > 0.0 {
             self.recent_travel_m / self.recent_time_s
         } else {
             speed
         };
-        let inflow = self.inflow_ratio.map_or(0.0, |k| k * u_ref);
+        let inflow = if up.is_some() {
+            let window_s = if u_ref > 0.0 {
+                (self.reference_travel_m / u_ref).max(self.recent_time_s)
+            } else {
+                self.recent_time_s
+            };
+            let window_s = if window_s.is_finite() {
+                window_s
+            } else {
+                self.recent_time_s
+            };
+            self.inflow.speed_m_s(u_ref, window_s)
+        } else {
+            0.0
+        };
         if self.started {
             let prev_vel = self.plate.pivot_vel_m_s;
             let angle = self.plate.angle_rad + 0.5 * (self.plate.angle_rate_rad_s + omega) * dt;
@@ -413,10 +446,11 @@ impl StripLdvm {
             -v[0].hypot(v[1]) * (v[0] * c + v[1] * s)
         };
         let l = ldvm.step(&self.plate, dt).ok()?;
-        Some(SectionLoads {
+        self.last_loads = SectionLoads {
             normal_n_m: self.cn_3d_factor * l.normal_n_m,
             chordwise_n_m: -l.chord_n_m - self.drag_factor * drag_speed2,
             moment_n: self.cn_3d_factor * l.moment_pivot_n,
-        })
+        };
+        Some(self.last_loads)
     }
 }
