@@ -1401,7 +1401,7 @@ fn frozen_wake_vortices_stay_where_they_were_shed() {
 /// The induced inflow of a strip is Galilean: a strip translating at U in fluid that sinks at
 /// w = k·U gives the loads of the same strip translating at U and rising at w through still
 /// fluid (attached flow, frozen wake, no merging, so that the two runs differ only in which
-/// frame carries the vertical speed).
+/// frame carries the vertical speed). A negative or NaN ratio is refused.
 #[test]
 fn strip_inflow_equals_the_plate_rising_through_still_fluid() {
     let geom = rcp_section();
@@ -1452,4 +1452,12 @@ fn strip_inflow_equals_the_plate_rising_through_still_fluid() {
     }
     // the fluid comes from above: the plate is pushed down (−x_w)
     assert!(sinking.last().unwrap().normal_n_m < 0.0);
+    for ratio in [-0.1, f64::NAN] {
+        let bad = StripLdvmParams {
+            inflow: Inflow::Uniform { ratio },
+            ..params
+        };
+        let e = bad.check(&geom).unwrap_err().to_string();
+        assert!(e.contains("inflow ratio"), "{e}");
+    }
 }

@@ -114,11 +114,11 @@ impl InflowState {
         } else {
             self.direction
         };
-        if sign != self.direction && self.direction != 0.0 && self.arc_m >= self.min_half_stroke_m {
+        if self.direction == 0.0 {
+            self.direction = sign;
+        } else if sign != self.direction && self.arc_m >= self.min_half_stroke_m {
             self.half_stroke_m = self.arc_m;
             self.arc_m = 0.0;
-        }
-        if sign != 0.0 && (self.direction == 0.0 || self.arc_m == 0.0) {
             self.direction = sign;
         }
         self.arc_m += horizontal_m_s.abs() * dt_s;

@@ -272,25 +272,25 @@ impl StripLdvm {
     }
 
     /// Pivot velocity (m/s) in the plane's axes relative to the fluid far away: the section's
-    /// velocity, plus `inflow_m_s` along the vertical when the fluid moves down (the plate
-    /// rises through it) and the section knows which way is up.
-    fn fluid_frame_velocity(angle_rad: f64, kin: &SectionKinematics, inflow_m_s: f64) -> [f64; 2] {
+    /// velocity, plus `inflow_m_s` along the unit vertical `up` ([x_w, y_w] components) when
+    /// the fluid moves down (the plate rises through it).
+    fn fluid_frame_velocity(
+        angle_rad: f64,
+        kin: &SectionKinematics,
+        up: Option<[f64; 2]>,
+        inflow_m_s: f64,
+    ) -> [f64; 2] {
         let (s, c) = angle_rad.sin_cos();
         let (n_hat, t_hat) = ([-s, c], [c, s]);
         // n̂ = x_w and t̂ = −y_w in the plane
-        let (vn, vt) = (kin.normal_velocity_m_s, -kin.chord_velocity_m_s);
-        let mut v = [vn * n_hat[0] + vt * t_hat[0], vn * n_hat[1] + vt * t_hat[1]];
-        if let Some([ux, uy]) = kin.up_section
+        let (mut vn, mut vt) = (kin.normal_velocity_m_s, -kin.chord_velocity_m_s);
+        if let Some([ux, uy]) = up
             && inflow_m_s != 0.0
         {
-            let up = [ux * n_hat[0] - uy * t_hat[0], ux * n_hat[1] - uy * t_hat[1]];
-            let norm = up[0].hypot(up[1]);
-            if norm > 1e-9 {
-                v[0] += inflow_m_s * up[0] / norm;
-                v[1] += inflow_m_s * up[1] / norm;
-            }
+            vn += inflow_m_s * ux;
+            vt -= inflow_m_s * uy;
         }
-        v
+        [vn * n_hat[0] + vt * t_hat[0], vn * n_hat[1] + vt * t_hat[1]]
     }
 }
 
@@ -406,14 +406,11 @@ impl StripLdvm {
         } else {
             speed
         };
-        let inflow = if up.is_some() {
-            let window_s = if u_ref > 0.0 {
+        let inflow = if up.is_some() && !self.inflow.is_still() {
+            // the time of s_U chords at U_ref (the weighted time since the start where longer,
+            // or where there is no s_U)
+            let window_s = if u_ref > 0.0 && self.reference_travel_m.is_finite() {
                 (self.reference_travel_m / u_ref).max(self.recent_time_s)
-            } else {
-                self.recent_time_s
-            };
-            let window_s = if window_s.is_finite() {
-                window_s
             } else {
                 self.recent_time_s
             };
@@ -424,13 +421,13 @@ impl StripLdvm {
         if self.started {
             let prev_vel = self.plate.pivot_vel_m_s;
             let angle = self.plate.angle_rad + 0.5 * (self.plate.angle_rate_rad_s + omega) * dt;
-            let vel = Self::fluid_frame_velocity(angle, kin, inflow);
+            let vel = Self::fluid_frame_velocity(angle, kin, up, inflow);
             self.plate.pivot_m[0] += 0.5 * (prev_vel[0] + vel[0]) * dt;
             self.plate.pivot_m[1] += 0.5 * (prev_vel[1] + vel[1]) * dt;
             self.plate.angle_rad = angle;
             self.plate.pivot_vel_m_s = vel;
         } else {
-            self.plate.pivot_vel_m_s = Self::fluid_frame_velocity(0.0, kin, inflow);
+            self.plate.pivot_vel_m_s = Self::fluid_frame_velocity(0.0, kin, up, inflow);
         }
         self.plate.angle_rate_rad_s = omega;
         self.prev_speed_m_s = speed;
