@@ -36,7 +36,7 @@ enum Command {
     Bench(cmd::bench::BenchArgs),
     /// Generate random wing trajectories (kinematics-only dataset).
     Trajectories(cmd::trajectories::TrajectoriesArgs),
-    /// Simulate the virtual robotic wing (L0/L1/L2 aerodynamics, sensor chain) into a dataset.
+    /// Simulate the virtual robotic wing (L0–L3 aerodynamics, sensor chain) into a dataset.
     Simulate(cmd::simulate::SimulateArgs),
     /// Quasi-steady baseline (LRQSM): elastic net with cross-validation.
     Qs {

@@ -196,3 +196,34 @@ fn simulate_takes_the_l2_wake_model_and_refuses_unknown_names() {
         assert_fails(&o, &[flag, said], &bad);
     }
 }
+
+/// `simulate --fidelity l3` runs the vortex lattice (recorded in the metadata, finite loads) and
+/// an unknown level is refused with the levels named.
+#[test]
+fn simulate_runs_the_vortex_lattice() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("l3.npz");
+    ok(&[
+        "simulate",
+        "--source",
+        "paper",
+        "--n",
+        "2",
+        "--fidelity",
+        "l3",
+        "--noise-free",
+        "--quiet",
+        "--out",
+        s(&out),
+    ]);
+    let ds = Dataset::load(&out).unwrap();
+    assert_eq!(ds.meta.settings["fidelity"], "l3");
+    let outputs = ds
+        .trajectories
+        .iter()
+        .flat_map(|t| t.outputs.as_ref().unwrap().iter());
+    assert!(outputs.flatten().all(|v| v.is_finite()));
+    let bad = dir.path().join("b.npz");
+    let o = flapssm(&["simulate", "--n", "2", "--fidelity", "l4", "--out", s(&bad)]);
+    assert_fails(&o, &["--fidelity", "expected l0, l1, l2 or l3"], &bad);
+}

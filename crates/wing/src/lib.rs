@@ -12,6 +12,7 @@ pub mod dataset;
 pub mod differentiate;
 pub mod features;
 pub mod kinematics;
+pub mod lattice;
 pub mod sensor;
 pub mod trajectories;
 pub mod virtual_wing;

@@ -19,6 +19,7 @@ use crate::cycles::{self, CycleError};
 use crate::dataset::{Dataset, Trajectory, ValidDataset};
 use crate::dataset::{DatasetMeta, FORMAT_VERSION, Fluid, INPUT_UNITS, OUTPUT_UNITS, WingGeometry};
 use crate::kinematics::{EulerState, WingKinematics, rotation_global_from_wing};
+use crate::lattice::{LatticeError, VortexLatticeParams, VortexLatticeWing};
 use crate::sensor::{DatasetSensorErrors, SensorConfig, measure};
 use crate::trajectories::{GeneratorConfig, TrajectoryError, TrajectorySpec};
 use crate::vortex::{StripLdvmFactory, StripLdvmParams, VortexError};
@@ -43,6 +44,9 @@ pub enum Fidelity {
     /// meets the speed target; 548 trajectories in ≈ 64 s on 2 cores).
     #[default]
     L2,
+    /// Unsteady vortex lattice of the whole plate with a prescribed shed wake
+    /// ([`crate::lattice`]; issue 27's 3-D candidate).
+    L3,
 }
 
 impl std::str::FromStr for Fidelity {
@@ -52,6 +56,7 @@ impl std::str::FromStr for Fidelity {
             "l0" => Ok(Fidelity::L0),
             "l1" => Ok(Fidelity::L1),
             "l2" => Ok(Fidelity::L2),
+            "l3" => Ok(Fidelity::L3),
             _ => Err(SimulateError::UnknownFidelity {
                 name: s.to_string(),
             }),
@@ -64,7 +69,7 @@ impl std::str::FromStr for Fidelity {
 #[non_exhaustive]
 pub enum SimulateError {
     /// Unknown fidelity name.
-    #[error("unknown fidelity `{name}` (expected l0, l1 or l2)")]
+    #[error("unknown fidelity `{name}` (expected l0, l1, l2 or l3)")]
     UnknownFidelity {
         /// The name given.
         name: String,
@@ -72,6 +77,9 @@ pub enum SimulateError {
     /// The L2 (LDVM) settings are invalid.
     #[error("invalid L2 setting: {0}")]
     InvalidL2(VortexError),
+    /// The L3 (vortex-lattice) settings are invalid.
+    #[error("invalid L3 setting: {0}")]
+    InvalidL3(#[from] LatticeError),
     /// A configuration value is out of range.
     #[error("invalid simulator setting `{field}` = {value}: {reason}")]
     InvalidConfig {
@@ -139,6 +147,8 @@ pub struct VirtualWingConfig {
     /// Blade-element strips at L2 (Gauss–Legendre; 2, exact for ∫r² and ∫r³; each strip is a
     /// vortex simulation, so `n_strips` applies to L0/L1 only).
     pub l2_strips: usize,
+    /// L3 parameters (vortex lattice, [`crate::lattice`]).
+    pub l3: VortexLatticeParams,
     /// Sensor and post-processing.
     pub sensor: SensorConfig,
 }
@@ -155,6 +165,7 @@ impl Default for VirtualWingConfig {
             aero: UnsteadyParams::default(),
             l2: StripLdvmParams::default(),
             l2_strips: 2,
+            l3: VortexLatticeParams::default(),
             sensor: SensorConfig::default(),
         }
     }
@@ -224,15 +235,20 @@ impl VirtualWingConfig {
             };
             self.l2.check(&section).map_err(SimulateError::InvalidL2)?;
         }
+        if self.fidelity == Fidelity::L3 {
+            self.l3.check()?;
+        }
         Ok(())
     }
 
-    /// The section-model factory of the fidelity.
-    pub fn factory(&self) -> Result<Box<dyn SectionModelFactory>, SimulateError> {
+    /// The section-model factory of a blade-element fidelity (`None` for L3, which models the
+    /// whole plate).
+    pub fn factory(&self) -> Option<Box<dyn SectionModelFactory>> {
         match self.fidelity {
-            Fidelity::L0 => Ok(Box::new(self.aero.quasi_steady)),
-            Fidelity::L1 => Ok(Box::new(self.aero)),
-            Fidelity::L2 => Ok(Box::new(StripLdvmFactory { params: self.l2 })),
+            Fidelity::L0 => Some(Box::new(self.aero.quasi_steady)),
+            Fidelity::L1 => Some(Box::new(self.aero)),
+            Fidelity::L2 => Some(Box::new(StripLdvmFactory { params: self.l2 })),
+            Fidelity::L3 => None,
         }
     }
 }
@@ -247,35 +263,56 @@ pub struct SimulationConfig {
     pub trajectories: GeneratorConfig,
 }
 
-/// A wing ready to run trajectories (holds the per-strip models; reuse it).
+/// A wing ready to run trajectories (holds the per-strip models or the lattice; reuse it).
 pub struct VirtualWing {
     cfg: VirtualWingConfig,
-    blade: BladeElement,
+    aero: Aerodynamics,
+}
+
+/// The aerodynamic model of a wing: strips (L0–L2) or the whole-plate lattice (L3).
+enum Aerodynamics {
+    Strips(BladeElement),
+    Lattice(Box<VortexLatticeWing>),
 }
 
 impl VirtualWing {
     /// Builds the wing.
     pub fn new(cfg: &VirtualWingConfig) -> Result<Self, SimulateError> {
         cfg.check()?;
-        let factory = cfg.factory()?;
-        let strips = match cfg.fidelity {
-            Fidelity::L2 => cfg.l2_strips,
-            Fidelity::L0 | Fidelity::L1 => cfg.n_strips,
+        let aero = match cfg.factory() {
+            Some(factory) => {
+                let strips = match cfg.fidelity {
+                    Fidelity::L2 => cfg.l2_strips,
+                    _ => cfg.n_strips,
+                };
+                let blade = BladeElement::new(cfg.blade_geometry(), strips, factory.as_ref())?;
+                Aerodynamics::Strips(blade)
+            }
+            None => Aerodynamics::Lattice(Box::new(VortexLatticeWing::new(
+                &cfg.l3,
+                &cfg.wing,
+                &cfg.fluid,
+                cfg.sensor_radius_m,
+            )?)),
         };
-        let blade = BladeElement::new(cfg.blade_geometry(), strips, factory.as_ref())?;
         Ok(Self {
             cfg: cfg.clone(),
-            blade,
+            aero,
         })
     }
 
     /// Exact aerodynamic loads [F_x, F_y (N), M_x, M_y, M_z (N·mm)] for Euler states sampled
     /// every `dt_s` from rest, written into `out` (same length as `states`).
     pub fn aero_loads_into(&mut self, states: &[EulerState], dt_s: f64, out: &mut [[f64; 5]]) {
-        self.blade.reset();
-        for (k, (st, y)) in states.iter().zip(out.iter_mut()).enumerate() {
-            let kin = WingKinematics::from_euler(st);
-            *y = self.blade.step(&kin, if k == 0 { 0.0 } else { dt_s });
+        match &mut self.aero {
+            Aerodynamics::Strips(blade) => {
+                blade.reset();
+                for (k, (st, y)) in states.iter().zip(out.iter_mut()).enumerate() {
+                    let kin = WingKinematics::from_euler(st);
+                    *y = blade.step(&kin, if k == 0 { 0.0 } else { dt_s });
+                }
+            }
+            Aerodynamics::Lattice(lattice) => lattice.loads_into(states, dt_s, out),
         }
     }
 
@@ -453,7 +490,6 @@ pub fn simulate_dataset(
     progress: &(dyn Fn() + Sync),
 ) -> Result<ValidDataset, SimulateError> {
     cfg.wing.check()?;
-    cfg.wing.factory()?;
     let specs = cfg.trajectories.generate()?;
     let sampling = &cfg.trajectories.sampling;
     let drive = |index: usize| {
@@ -492,7 +528,6 @@ pub fn simulate_angles_dataset(
     progress: &(dyn Fn() + Sync),
 ) -> Result<ValidDataset, SimulateError> {
     wing.check()?;
-    wing.factory()?;
     let drive = |index: usize| {
         crate::trajectories::measured::raw_states(&angles_rad[index], sampling)
             .map(|states| (states, "measured".to_string()))

@@ -293,7 +293,7 @@ struct Memory {
 }
 
 /// The three figures for the wing `chordwise` on the generator (`flat` or default), with the
-/// memory measured on data of `fidelity` (L1 or L2).
+/// memory measured on data of `fidelity` (L1, L2 or L3).
 fn memory(set: Set, chordwise: Chordwise, fidelity: Fidelity) -> Memory {
     let label = format!("{set:?}, {chordwise:?}, {fidelity:?}");
     let (ds0, _) = dataset(Fidelity::L0, set, chordwise);
@@ -427,7 +427,7 @@ fn study_l2_memory_evidence() {
     memory(Set::FlatHovering, Chordwise::FrictionOnly, Fidelity::L2);
 }
 
-/// The memory figures of the default wing on the paper's measured trajectories (L1 and L2,
+/// The memory figures of the default wing on the paper's measured trajectories (L1, L2, L3,
 /// noise-free, the first 72), for the record (docs/vortex-method.md, round 10). A study, not a
 /// check: `cargo test --release -p flapssm-wing --test memory paper_memory_study -- --ignored
 /// --nocapture`.
@@ -436,4 +436,5 @@ fn study_l2_memory_evidence() {
 fn paper_memory_study() {
     memory(Set::Paper, Chordwise::Full, Fidelity::L1);
     memory(Set::Paper, Chordwise::Full, Fidelity::L2);
+    memory(Set::Paper, Chordwise::Full, Fidelity::L3);
 }

@@ -25,7 +25,8 @@ pub struct SimulateArgs {
     /// Seed of the generated trajectories and of the sensor noise (same seed → identical file).
     #[arg(long, value_name = "S", default_value_t = 0)]
     seed: u64,
-    /// Aerodynamic fidelity: l0 (quasi-steady), l1 (unsteady low-order), l2 (vortex strips).
+    /// Aerodynamic fidelity: l0 (quasi-steady), l1 (unsteady low-order), l2 (vortex strips), l3
+    /// (vortex lattice of the whole plate with a prescribed wake).
     #[arg(long, value_name = "LEVEL", default_value = "l2")]
     fidelity: String,
     /// Output dataset file (.npz).
