@@ -279,20 +279,16 @@ impl VortexLatticeWing {
         }
         let shed_start = (nc - 1) * ns;
         s.shed.copy_from_slice(&s.gamma[shed_start..]);
-        if s.started {
-            s.wake.shed(
-                [0.0, -w * dt_s, 0.0],
-                &s.trailing_edge,
-                &s.shed,
-                s.time_s,
-                s.travel_m,
-            );
-            s.wake
-                .prune(s.travel_m - self.params.wake_length_chords * self.chord_m);
-        } else {
-            s.wake
-                .shed([0.0; 3], &s.trailing_edge, &s.shed, s.time_s, s.travel_m);
-        }
+        // The fluid carries the wake down by w·Δt (nothing at the first step, Δt = 0).
+        s.wake.shed(
+            [0.0, -w * dt_s, 0.0],
+            &s.trailing_edge,
+            &s.shed,
+            s.time_s,
+            s.travel_m,
+        );
+        s.wake
+            .prune(s.travel_m - self.params.wake_length_chords * self.chord_m);
         for (k, p) in self.collocation.iter().enumerate() {
             s.points_global.set(k, mul(&r, *p));
         }
