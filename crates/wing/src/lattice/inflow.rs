@@ -11,8 +11,23 @@
 //! L̄ = Σ e^{−s/(s_U c)} L Δs / (s_U c), the vertical force averaged over the last s_U chords of
 //! travel of the reference point (a full window from the start, so w builds up from rest). As
 //! for the strips (`vortex::inflow`), w ∝ U under time scaling and w = 0 at rest.
+//!
+//! The slipstream below the wing speeds up from w at the stroke plane to 2w far below (the
+//! momentum balance): on the axis of the vortex-cylinder model of an actuator disk of radius R,
+//! the fluid at depth d below the disk moves down at
+//!
+//! v(d) = w·(1 + d/√(d² + R²))   (w/2·… → 0 far above, 2w far below),
+//!
+//! which [`slipstream_speed`] gives and which carries the prescribed wake: a wake sinking at w
+//! everywhere would pile up twice the far wake's vorticity under the wing.
 
 use crate::vortex::Inflow;
+
+/// Downward speed (m/s) of the fluid at depth `depth_m` below the stroke plane (negative above
+/// it) in the slipstream of a disk of radius `radius_m` whose induced velocity is `w_m_s`.
+pub(crate) fn slipstream_speed(w_m_s: f64, depth_m: f64, radius_m: f64) -> f64 {
+    w_m_s * (1.0 + depth_m / depth_m.hypot(radius_m))
+}
 
 /// Reversals closer together than this (chords of travel of the reference point) are not
 /// half-strokes.
@@ -124,5 +139,23 @@ impl WingInflow {
                 (lift.max(0.0) / (self.two_rho_area_per_rad * sweep)).sqrt()
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The slipstream moves at w in the stroke plane, 2w far below, nothing far above, and
+    /// speeds up monotonically on the way down.
+    #[test]
+    fn slipstream_doubles_below_the_wing() {
+        let (w, r) = (0.05, 0.235);
+        assert_eq!(slipstream_speed(w, 0.0, r), w);
+        assert!((slipstream_speed(w, 1e3, r) - 2.0 * w).abs() < 1e-7);
+        assert!(slipstream_speed(w, -1e3, r) < 1e-8);
+        let depths = [-0.5, -0.1, 0.0, 0.1, 0.5, 2.0];
+        let speeds: Vec<f64> = depths.iter().map(|&d| slipstream_speed(w, d, r)).collect();
+        assert!(speeds.windows(2).all(|v| v[1] > v[0]), "{speeds:?}");
     }
 }

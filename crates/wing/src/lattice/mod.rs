@@ -16,9 +16,10 @@
 //! A_kl the normal velocity at point k of ring l of unit strength (constant for the rigid plate:
 //! inverted once). Every step the trailing-edge rings shed their strengths of the step before as
 //! a new row of wake rings between the trailing-edge lines of the two steps (the Kutta
-//! condition). The wake is prescribed: it stays in the fluid, which moves straight down at the
-//! induced inflow w of momentum theory (module `inflow`); it does not move itself, so the loads
-//! are a smooth function of the kinematics, not chaotic. The shed vorticity leaves the plate
+//! condition). The wake is prescribed: it stays in the fluid, which moves straight down in the
+//! slipstream of momentum theory, at the induced inflow w in the stroke plane and speeding up to
+//! 2w far below (module `inflow`); it does not move itself, so the loads are a smooth function
+//! of the kinematics, not chaotic. The shed vorticity leaves the plate
 //! spread over its boundary layer: a new filament's core is the Blasius thickness at the trailing
 //! edge, r_c0 = 5c/√Re (0.158c at Re = 1000), and it grows by viscous diffusion,
 //! r_c² = r_c0² + 4·1.25643·ν·t (Lamb–Oseen); the filament on the trailing edge itself has the

@@ -69,24 +69,20 @@ impl Wake {
         self.shed_time_s.len()
     }
 
-    /// One step: every line so far is carried by `shift_m` (the fluid's displacement over the
-    /// step), then `trailing_edge` (the current trailing-edge line, global) is added with the
-    /// ring between it and the last line of strength `shed` per column (the bound
-    /// trailing-edge strengths of the step before). The first call only records the line.
+    /// One step: every node so far is moved by `carry` (the fluid's displacement over the step),
+    /// then `trailing_edge` (the current trailing-edge line, global) is added with the ring
+    /// between it and the last line of strength `shed` per column (the bound trailing-edge
+    /// strengths of the step before). The first call only records the line.
     pub fn shed(
         &mut self,
-        shift_m: [f64; 3],
+        carry: impl Fn(&mut [f64; 3]),
         trailing_edge: &[[f64; 3]],
         shed: &[f64],
         time_s: f64,
         travel_m: f64,
     ) {
         debug_assert_eq!(trailing_edge.len(), self.nodes);
-        for p in &mut self.points {
-            for (a, d) in p.iter_mut().zip(shift_m) {
-                *a += d;
-            }
-        }
+        self.points.iter_mut().for_each(carry);
         if self.lines() > 0 {
             self.strengths.extend_from_slice(shed);
         }
@@ -184,10 +180,11 @@ mod tests {
     fn shed_rows_move_with_the_fluid_and_go_whole() {
         let mut wake = Wake::new(2, 0.0, 0.0);
         let line = |x: f64| [[x, 0.0, 0.0], [x, 0.0, 1.0], [x, 0.0, 2.0]];
-        wake.shed([0.0; 3], &line(0.0), &[9.0, 9.0], 0.0, 0.0);
+        let sink = |p: &mut [f64; 3]| p[1] -= 0.5;
+        wake.shed(|_| {}, &line(0.0), &[9.0, 9.0], 0.0, 0.0);
         assert_eq!(wake.rows(), 0);
-        wake.shed([0.0, -0.5, 0.0], &line(1.0), &[1.0, 2.0], 0.1, 1.0);
-        wake.shed([0.0, -0.5, 0.0], &line(2.0), &[3.0, 4.0], 0.2, 2.0);
+        wake.shed(sink, &line(1.0), &[1.0, 2.0], 0.1, 1.0);
+        wake.shed(sink, &line(2.0), &[3.0, 4.0], 0.2, 2.0);
         assert_eq!(wake.rows(), 2);
         assert_eq!(wake.row(0), &[1.0, 2.0]);
         assert_eq!(wake.line(0)[1], [0.0, -1.0, 1.0]);
@@ -206,14 +203,14 @@ mod tests {
     fn a_far_ring_is_a_dipole() {
         let mut wake = Wake::new(1, 0.0, 0.0);
         wake.shed(
-            [0.0; 3],
+            |_| {},
             &[[0.0, 0.0, 0.0], [0.0, 0.0, 0.1]],
             &[0.0],
             0.0,
             0.0,
         );
         wake.shed(
-            [0.0; 3],
+            |_| {},
             &[[0.1, 0.0, 0.0], [0.1, 0.0, 0.1]],
             &[2.0],
             0.0,

@@ -2,7 +2,7 @@
 //! unsteady Bernoulli equation and the leading-edge suction (module docs of [`super`]).
 
 use super::biot_savart::{Points, cross, dot, segment_velocity, sub};
-use super::inflow::WingInflow;
+use super::inflow::{WingInflow, slipstream_speed};
 use super::wake::Wake;
 use super::{LatticeError, VortexLatticeParams};
 use crate::dataset::{Fluid, WingGeometry};
@@ -17,6 +17,8 @@ pub struct VortexLatticeWing {
     density_kg_m3: f64,
     viscosity_m2_s: f64,
     sensor_radius_m: f64,
+    /// Radius of the wing tip (m): the disk of the slipstream.
+    tip_radius_m: f64,
     /// Reference point (pitch axis at the U_ref radius), wing frame (m).
     reference_point: [f64; 3],
     chordwise: usize,
@@ -152,6 +154,7 @@ impl VortexLatticeWing {
             density_kg_m3: rho,
             viscosity_m2_s: fluid.kinematic_viscosity_m2_s,
             sensor_radius_m,
+            tip_radius_m: wing.root_offset_m + wing.span_m,
             reference_point: [0.0, 0.0, wing.u_ref_radius_m],
             chordwise: nc,
             spanwise: ns,
@@ -279,9 +282,10 @@ impl VortexLatticeWing {
         }
         let shed_start = (nc - 1) * ns;
         s.shed.copy_from_slice(&s.gamma[shed_start..]);
-        // The fluid carries the wake down by w·Δt (nothing at the first step, Δt = 0).
+        // The slipstream carries the wake down (nothing at the first step, Δt = 0).
+        let radius = self.tip_radius_m;
         s.wake.shed(
-            [0.0, -w * dt_s, 0.0],
+            |p| p[1] -= slipstream_speed(w, -p[1], radius) * dt_s,
             &s.trailing_edge,
             &s.shed,
             s.time_s,
