@@ -36,11 +36,11 @@
 //! ```text
 //! spanwise filament (i, j):   ΔF_x = ρ (Γ_ij − Γ_{i−1,j}) Q_y Δs       at the quarter line
 //! streamwise filament (i, j): ΔF_x = −ρ (Γ_ij − Γ_{i,j−1}) Q_z Δc      at the node line
-//! ring (i, j):                ΔF_x = −ρ ∂Γ_ij/∂t Δc Δs                   at the ring centre
+//! ring (i, j):                ΔF_x = −ρ ∂Γ_ij/∂t ΔS (its area on the plate) at the ring centre
 //! ```
 //!
 //! A thin plate carries a chordwise force only at its leading edge, whose singularity is locally
-//! 2-D: with γ ≈ A/√x near the edge, the first panel's circulation is Γ_0j = 2A√c·g(Δc/c),
+//! 2-D: with γ ≈ A/√x near the edge, the first panel's circulation is Γ_0j = A√c·g(Δc/c),
 //! g(θ) = √(θ(1 − θ)) + asin √θ (exact for the thin-airfoil loading), and the suction per span is
 //! πρA²/4 = πρΓ_0j²/(4c g²) (N/m; for steady 2-D flow πρU²cα², the lift times α). The LESP of the
 //! column is A/(2U√c) = Γ_0j/(2cgU), U the column's speed relative to the fluid at the pitch
