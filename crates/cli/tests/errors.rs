@@ -246,12 +246,12 @@ fn bad_inputs_are_refused_naming_the_file_and_writing_nothing() {
         ),
         // unknown fidelity level
         (
-            vec!["simulate", "--n", "2", "--fidelity", "l3", "--out", "OUT"],
-            vec!["--fidelity", "l3"],
+            vec!["simulate", "--n", "2", "--fidelity", "l4", "--out", "OUT"],
+            vec!["--fidelity", "l4"],
         ),
         (
-            vec!["demo", "--fidelity", "l3", "--out", "OUT"],
-            vec!["--fidelity", "l3"],
+            vec!["demo", "--fidelity", "l4", "--out", "OUT"],
+            vec!["--fidelity", "l4"],
         ),
         // no outputs to train on
         (
