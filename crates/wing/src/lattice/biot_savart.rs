@@ -1,40 +1,8 @@
-//! The velocity induced by a straight vortex segment (Biot–Savart), with a smoothed core.
+//! The velocity induced by a straight vortex segment (Biot–Savart), with a smoothed core, at
+//! many points at once.
 
 /// 1/(4π).
 const INV_4PI: f64 = 0.25 / std::f64::consts::PI;
-
-/// Velocity (m/s) induced at `x` by the segment `p1 → p2` (m) of circulation Γ = `gamma`
-/// (m²/s, positive by the right-hand rule along p1 → p2), with core radius r_c (m):
-///
-/// ```text
-/// v = Γ/(4π) · (r1 × r2) / (|r1 × r2|² + r_c²|r0|²) · r0·(r1/|r1| − r2/|r2|),
-/// ```
-///
-/// r1 = x − p1, r2 = x − p2, r0 = p2 − p1. With r_c = 0 it is the exact filament; the core
-/// replaces the 1/h singularity at distance h from the line by h/(h² + r_c²) (the
-/// algebraic core of Katz & Plotkin §10.4.5). Zero on the segment's own line.
-#[inline]
-pub fn segment_velocity(
-    x: [f64; 3],
-    p1: [f64; 3],
-    p2: [f64; 3],
-    gamma: f64,
-    core_m: f64,
-) -> [f64; 3] {
-    let r1 = sub(x, p1);
-    let r2 = sub(x, p2);
-    let r0 = sub(p2, p1);
-    let c = cross(r1, r2);
-    let r0_sq = dot(r0, r0);
-    let den = dot(c, c) + core_m * core_m * r0_sq;
-    let n1 = dot(r1, r1).sqrt();
-    let n2 = dot(r2, r2).sqrt();
-    if den <= 1e-30 * r0_sq * r0_sq || n1 == 0.0 || n2 == 0.0 {
-        return [0.0; 3];
-    }
-    let k = INV_4PI * gamma * (dot(r0, r1) / n1 - dot(r0, r2) / n2) / den;
-    [k * c[0], k * c[1], k * c[2]]
-}
 
 /// Points (or velocities) stored by coordinate, so that a segment's velocity at all of them
 /// runs in SIMD lanes.
@@ -69,10 +37,19 @@ impl Points {
     }
 }
 
-/// Adds to `out` the velocity that the segment `p1 → p2` (circulation `gamma`, core `core_m`)
-/// induces at each of `points`: [`segment_velocity`] without branches (a point on the
-/// segment's line gets zero through the floor on the denominator, which is far below any
-/// distance that occurs).
+/// Adds to `out` the velocity (m/s) that the segment `p1 → p2` (m) of circulation Γ = `gamma`
+/// (m²/s, positive by the right-hand rule along p1 → p2) with core radius r_c = `core_m` (m)
+/// induces at each of `points`:
+///
+/// ```text
+/// v = Γ/(4π) · (r1 × r2) / (|r1 × r2|² + r_c²|r0|²) · r0·(r1/|r1| − r2/|r2|),
+/// ```
+///
+/// r1 = x − p1, r2 = x − p2, r0 = p2 − p1. With r_c = 0 it is the exact filament; the core
+/// replaces the 1/h singularity at distance h from the line by h/(h² + r_c²) (the algebraic
+/// core of Katz & Plotkin §10.4.5). Without branches, so that it runs in SIMD lanes: a point on
+/// the segment's line gets zero through the floor on the denominator, far below any distance
+/// that occurs.
 pub(crate) fn add_segment_velocity(
     points: &Points,
     out: &mut Points,
@@ -131,10 +108,24 @@ mod tests {
 
     /// An infinite line (a long segment) induces Γ/(2πh) around itself; a finite one
     /// Γ/(4πh)(cos θ1 − cos θ2); the core only matters within a few r_c.
+    /// The velocity of one segment at one point.
+    fn at(x: [f64; 3], p1: [f64; 3], p2: [f64; 3], gamma: f64, core: f64) -> [f64; 3] {
+        let points = Points {
+            x: vec![x[0]],
+            y: vec![x[1]],
+            z: vec![x[2]],
+        };
+        let mut v = Points::zeros(1);
+        add_segment_velocity(&points, &mut v, p1, p2, gamma, core);
+        v.get(0)
+    }
+
+    /// An infinite line (a long segment) induces Γ/(2πh) around itself; a finite one
+    /// Γ/(4πh)(cos θ1 − cos θ2); the core only matters within a few r_c; nothing on the line.
     #[test]
     fn segment_matches_the_closed_forms() {
         let gamma = 2.0;
-        let v = segment_velocity(
+        let v = at(
             [0.0, 0.5, 0.0],
             [0.0, 0.0, -1e6],
             [0.0, 0.0, 1e6],
@@ -145,7 +136,7 @@ mod tests {
         let exact = gamma / (2.0 * std::f64::consts::PI * 0.5);
         assert!((v[0] + exact).abs() < 1e-9 * exact && v[1].abs() < 1e-12 && v[2].abs() < 1e-12);
         // Unit segment seen from its perpendicular bisector at h = 1: cos θ = ±1/√5.
-        let v = segment_velocity(
+        let v = at(
             [0.0, 1.0, 0.5],
             [0.0, 0.0, 0.0],
             [0.0, 0.0, 1.0],
@@ -155,7 +146,7 @@ mod tests {
         let exact = gamma / (4.0 * std::f64::consts::PI) * 2.0 / 5f64.sqrt();
         assert!((v[0] + exact).abs() < 1e-12);
         // A core of 1 % of h changes the velocity by ≈ 1e-4 relative.
-        let w = segment_velocity(
+        let w = at(
             [0.0, 1.0, 0.5],
             [0.0, 0.0, 0.0],
             [0.0, 0.0, 1.0],
@@ -163,9 +154,12 @@ mod tests {
             0.01,
         );
         assert!(((w[0] - v[0]) / v[0] + 1e-4).abs() < 1e-6);
-        assert_eq!(
-            segment_velocity([0.0, 0.0, 2.0], [0.0; 3], [0.0, 0.0, 1.0], gamma, 0.0),
-            [0.0; 3]
-        );
+        for x in [[0.0, 0.0, 2.0], [0.0, 0.0, 0.0], [0.0, 0.0, 0.5]] {
+            assert_eq!(
+                at(x, [0.0; 3], [0.0, 0.0, 1.0], gamma, 0.0),
+                [0.0; 3],
+                "{x:?}"
+            );
+        }
     }
 }

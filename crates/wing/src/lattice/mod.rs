@@ -62,9 +62,9 @@ mod inflow;
 mod wake;
 mod wing;
 
-pub use biot_savart::segment_velocity;
 pub use wing::VortexLatticeWing;
 
+use crate::check::first_not_positive;
 use crate::vortex::{Inflow, strip::zero_incidence_drag};
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
@@ -150,14 +150,12 @@ impl VortexLatticeParams {
                 return bad(name, n as f64, "must be in 1..=64");
             }
         }
-        for (name, v) in [
+        if let Some((name, v)) = first_not_positive(&[
             ("step_chords", self.step_chords),
             ("wake_length_chords", self.wake_length_chords),
             ("inflow_window_chords", self.inflow_window_chords),
-        ] {
-            if !(v.is_finite() && v > 0.0) {
-                return bad(name, v, "must be finite and > 0");
-            }
+        ]) {
+            return bad(name, v, "must be finite and > 0");
         }
         for (name, v) in [
             ("core_radius_frac", self.core_radius_frac.unwrap_or(0.0)),

@@ -61,6 +61,7 @@ impl Wake {
     }
 
     /// Number of rings (rows of the wake).
+    #[cfg(test)]
     pub fn rows(&self) -> usize {
         self.strengths.len() / (self.nodes - 1)
     }

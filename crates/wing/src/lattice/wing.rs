@@ -1,7 +1,7 @@
 //! The unsteady vortex-lattice wing: bound rings on the plate, a shed wake, loads from the
 //! unsteady Bernoulli equation and the leading-edge suction (module docs of [`super`]).
 
-use super::biot_savart::{Points, cross, dot, segment_velocity, sub};
+use super::biot_savart::{Points, add_segment_velocity, cross, dot, sub};
 use super::inflow::{WingInflow, slipstream_speed};
 use super::wake::Wake;
 use super::{LatticeError, VortexLatticeParams};
@@ -103,7 +103,14 @@ impl VortexLatticeWing {
             })
             .collect();
         let n = nc * ns;
-        let influence = faer::Mat::<f64>::from_fn(n, n, |k, l| {
+        // Column l: the normal velocity at every collocation point of ring l of unit strength.
+        let mut points = Points::zeros(n);
+        for (k, p) in collocation.iter().enumerate() {
+            points.set(k, *p);
+        }
+        let mut velocity = Points::zeros(n);
+        let mut influence = faer::Mat::<f64>::zeros(n, n);
+        for l in 0..n {
             let (i, j) = (l / ns, l % ns);
             let corners = [
                 [0.0, ring_y[i], node_z[j]],
@@ -111,12 +118,21 @@ impl VortexLatticeWing {
                 [0.0, ring_y[i + 1], node_z[j + 1]],
                 [0.0, ring_y[i + 1], node_z[j]],
             ];
-            (0..4)
-                .map(|e| {
-                    segment_velocity(collocation[k], corners[e], corners[(e + 1) % 4], 1.0, 0.0)[0]
-                })
-                .sum()
-        });
+            velocity.fill_zero();
+            for e in 0..4 {
+                add_segment_velocity(
+                    &points,
+                    &mut velocity,
+                    corners[e],
+                    corners[(e + 1) % 4],
+                    1.0,
+                    0.0,
+                );
+            }
+            for k in 0..n {
+                influence[(k, l)] = velocity.x[k];
+            }
+        }
         let inverse = influence.partial_piv_lu().inverse();
         let influence_inverse = (0..n * n).map(|kl| inverse[(kl / n, kl % n)]).collect();
         let theta = panel(0) / c;
@@ -188,17 +204,6 @@ impl VortexLatticeWing {
         self.state.wake.clear();
     }
 
-    /// Rows of the shed wake now.
-    pub fn wake_rows(&self) -> usize {
-        self.state.wake.rows()
-    }
-
-    /// Bound ring circulations Γ (m²/s), index i·N_s + j (i chordwise from the LE, j spanwise
-    /// from the root).
-    pub fn circulation(&self) -> &[f64] {
-        &self.state.gamma
-    }
-
     /// Mean speed (m/s) of the reference point over `states`.
     pub fn mean_reference_speed(&self, states: &[EulerState]) -> f64 {
         states
@@ -217,7 +222,12 @@ impl VortexLatticeWing {
     /// the reference point travels `step_chords` chords at its mean speed over `states`
     /// (at least 1), so that the lattice steps scale with the motion.
     pub fn samples_per_step(&self, states: &[EulerState], dt_s: f64) -> usize {
-        let per_sample = self.mean_reference_speed(states) * dt_s;
+        self.samples_per_step_at(self.mean_reference_speed(states), dt_s)
+    }
+
+    /// [`Self::samples_per_step`] for a known mean speed (m/s).
+    fn samples_per_step_at(&self, mean_speed_m_s: f64, dt_s: f64) -> usize {
+        let per_sample = mean_speed_m_s * dt_s;
         if per_sample > 0.0 {
             ((self.params.step_chords * self.chord_m / per_sample).round() as usize).max(1)
         } else {
@@ -245,8 +255,9 @@ impl VortexLatticeWing {
         if n == 0 {
             return;
         }
-        let every = self.samples_per_step(states, dt_s);
-        self.set_reference_speed(self.mean_reference_speed(states));
+        let speed = self.mean_reference_speed(states);
+        let every = self.samples_per_step_at(speed, dt_s);
+        self.set_reference_speed(speed);
         out[0] = self.step(&states[0], 0.0);
         let mut k = 0;
         while k + 1 < n {
