@@ -281,3 +281,100 @@ fn l3_wake_capture_study() {
          wake, {b:.4} N with it deleted; QS {q:.4} N"
     );
 }
+
+/// Every out-of-range L3 setting is refused by the wing's constructor with the field named
+/// and its value, and nothing is built.
+#[test]
+fn invalid_settings_are_refused_naming_the_field() {
+    use flapssm_wing::lattice::LatticeError;
+    use flapssm_wing::virtual_wing::{Fidelity, SimulateError, VirtualWing, VirtualWingConfig};
+    let ok = VortexLatticeParams::default();
+    let cases: [(&str, VortexLatticeParams); 10] = [
+        (
+            "chordwise_panels",
+            VortexLatticeParams {
+                chordwise_panels: 0,
+                ..ok
+            },
+        ),
+        (
+            "spanwise_panels",
+            VortexLatticeParams {
+                spanwise_panels: 65,
+                ..ok
+            },
+        ),
+        (
+            "step_chords",
+            VortexLatticeParams {
+                step_chords: 0.0,
+                ..ok
+            },
+        ),
+        (
+            "wake_length_chords",
+            VortexLatticeParams {
+                wake_length_chords: f64::NAN,
+                ..ok
+            },
+        ),
+        (
+            "inflow_window_chords",
+            VortexLatticeParams {
+                inflow_window_chords: -1.0,
+                ..ok
+            },
+        ),
+        (
+            "core_radius_frac",
+            VortexLatticeParams {
+                core_radius_frac: Some(-0.1),
+                ..ok
+            },
+        ),
+        (
+            "profile_drag",
+            VortexLatticeParams {
+                profile_drag: f64::INFINITY,
+                ..ok
+            },
+        ),
+        (
+            "lesp_crit",
+            VortexLatticeParams {
+                lesp_crit: Some(0.0),
+                ..ok
+            },
+        ),
+        (
+            "inflow",
+            VortexLatticeParams {
+                inflow: Inflow::Uniform { ratio: -0.5 },
+                ..ok
+            },
+        ),
+        (
+            "core_radius_frac",
+            VortexLatticeParams {
+                core_radius_frac: Some(f64::NAN),
+                ..ok
+            },
+        ),
+    ];
+    for (field, l3) in cases {
+        let cfg = VirtualWingConfig {
+            fidelity: Fidelity::L3,
+            l3,
+            ..VirtualWingConfig::default()
+        };
+        match VirtualWing::new(&cfg) {
+            Err(e @ SimulateError::InvalidL3(LatticeError::InvalidParameter { name, .. })) => {
+                assert_eq!(name, field);
+                assert!(e.to_string().contains(field), "{e}");
+            }
+            Err(e) => panic!("{field}: unexpected error {e}"),
+            Ok(_) => panic!("{field}: an invalid setting was accepted"),
+        }
+    }
+    assert!(ok.check().is_ok());
+}

@@ -16,7 +16,7 @@
 //! momentum balance): on the axis of the vortex-cylinder model of an actuator disk of radius R,
 //! the fluid at depth d below the disk moves down at
 //!
-//! v(d) = w·(1 + d/√(d² + R²))   (w/2·… → 0 far above, 2w far below),
+//! v(d) = w·(1 + d/√(d² + R²))   (→ 0 far above, 2w far below),
 //!
 //! which [`slipstream_speed`] gives and which carries the prescribed wake: a wake sinking at w
 //! everywhere would pile up twice the far wake's vorticity under the wing.
