@@ -3,6 +3,8 @@
 mod common;
 
 use common::{assert_fails, flapssm, ok, s};
+use std::path::Path;
+
 use flapssm_wing::dataset::Dataset;
 
 fn generate(dir: &std::path::Path, name: &str, extra: &[&str]) -> std::path::PathBuf {
@@ -162,6 +164,8 @@ fn simulate_takes_the_l2_wake_model_and_refuses_unknown_names() {
         "paper",
         "--n",
         "2",
+        "--fidelity",
+        "l2",
         "--wake",
         "frozen",
         "--inflow",
@@ -195,34 +199,54 @@ fn simulate_takes_the_l2_wake_model_and_refuses_unknown_names() {
         let o = flapssm(&["simulate", "--n", "2", flag, value, "--out", s(&bad)]);
         assert_fails(&o, &[flag, said], &bad);
     }
+    // A wake motion only the strips have, or an inflow at a fidelity without one, is refused
+    // rather than ignored.
+    for (args, said) in [
+        (
+            ["--wake", "frozen", "--fidelity", "l3"],
+            "setting wake = frozen",
+        ),
+        (
+            ["--inflow", "momentum", "--fidelity", "l1"],
+            "setting inflow = momentum",
+        ),
+    ] {
+        let mut argv = vec!["simulate", "--n", "2", "--out", s(&bad)];
+        argv.extend(args);
+        assert_fails(&flapssm(&argv), &[said, "applies to"], &bad);
+    }
 }
 
-/// `simulate --fidelity l3` runs the vortex lattice (recorded in the metadata, finite loads) and
-/// an unknown level is refused with the levels named.
+/// `simulate` runs the vortex lattice by default and `--inflow` sets its wake's inflow (both
+/// recorded in the metadata; finite loads, changed by the inflow), and an unknown level is
+/// refused with the levels named.
 #[test]
 fn simulate_runs_the_vortex_lattice() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("l3.npz");
-    ok(&[
-        "simulate",
-        "--source",
-        "paper",
-        "--n",
-        "2",
-        "--fidelity",
-        "l3",
-        "--noise-free",
-        "--quiet",
-        "--out",
-        s(&out),
-    ]);
-    let ds = Dataset::load(&out).unwrap();
-    assert_eq!(ds.meta.settings["fidelity"], "l3");
-    let outputs = ds
-        .trajectories
-        .iter()
-        .flat_map(|t| t.outputs.as_ref().unwrap().iter());
-    assert!(outputs.flatten().all(|v| v.is_finite()));
+    let still = dir.path().join("still.npz");
+    let run = |extra: &[&str], out: &Path| {
+        let mut argv = vec!["simulate", "--source", "paper", "--n", "2", "--noise-free"];
+        argv.extend(extra);
+        argv.extend(["--quiet", "--out", s(out)]);
+        ok(&argv);
+        Dataset::load(out).unwrap()
+    };
+    // The default wing is L3; --inflow sets what carries its wake (momentum by default).
+    let ds = run(&[], &out);
+    let ds_still = run(&["--fidelity", "l3", "--inflow", "still"], &still);
+    for (d, inflow) in [(&ds, "momentum"), (&ds_still, "still")] {
+        assert_eq!(d.meta.settings["fidelity"], "l3");
+        assert_eq!(d.meta.settings["wing"]["l3"]["inflow"], inflow);
+    }
+    let outputs = |d: &Dataset| -> Vec<f64> {
+        d.trajectories
+            .iter()
+            .flat_map(|t| t.outputs.as_ref().unwrap().iter().flatten().copied())
+            .collect()
+    };
+    assert!(outputs(&ds).iter().all(|v| v.is_finite()));
+    assert_ne!(outputs(&ds), outputs(&ds_still));
     let bad = dir.path().join("b.npz");
     let o = flapssm(&["simulate", "--n", "2", "--fidelity", "l4", "--out", s(&bad)]);
     assert_fails(&o, &["--fidelity", "expected l0, l1, l2 or l3"], &bad);

@@ -97,7 +97,7 @@ impl DemoConfig {
     /// exponentially to 0.005, 1000 epochs (41 000 steps).
     /// See docs/demo.md for its wall time.
     ///
-    /// The wing is `flapssm simulate`'s default (L2, the same for every command; chosen on
+    /// The wing is `flapssm simulate`'s default (L3, the same for every command; chosen on
     /// physics, not on the demo's outcome).
     pub fn default_for(seed: u64) -> Self {
         let mut simulation = SimulationConfig::default();
@@ -136,7 +136,7 @@ impl DemoConfig {
     /// trajectories (512 train, 36 test; [`TrajectorySource::Paper`]), D_x 12, M 100, 30 particles, minibatches of 16, lr 0.03, 1000 epochs; all 512
     /// training trajectories fitted (no validation hold-out: the normalization is theirs and an
     /// epoch is 32 minibatches, 32 000 steps in all) and the model of the lowest epoch-mean
-    /// training loss kept, as the authors' `best.ckpt`; the default wing (L2).
+    /// training loss kept, as the authors' `best.ckpt`; the default wing (L3).
     pub fn full(seed: u64) -> Self {
         let mut simulation = SimulationConfig::default();
         simulation.trajectories.seed = seed;

@@ -31,10 +31,12 @@ pub struct SimulateSettings {
     pub noise_free: bool,
     /// No stroke deviation (planar strokes).
     pub flat: bool,
-    /// How the L2 strips' free vortices move.
-    pub wake_motion: WakeMotion,
-    /// The L2 strips' induced inflow.
-    pub inflow: Inflow,
+    /// How the L2 strips' free vortices move (`None`: the strips' default, free); refused at
+    /// any other fidelity.
+    pub wake_motion: Option<WakeMotion>,
+    /// The induced inflow of the L2 strips or of the L3 lattice's wake (`None`: the fidelity's
+    /// default, still for L2 and momentum for L3); refused at L0 and L1.
+    pub inflow: Option<Inflow>,
 }
 
 impl Default for SimulateSettings {
@@ -47,8 +49,8 @@ impl Default for SimulateSettings {
             fidelity: VirtualWingConfig::default().fidelity,
             noise_free: false,
             flat: false,
-            wake_motion: WakeMotion::default(),
-            inflow: Inflow::default(),
+            wake_motion: None,
+            inflow: None,
         }
     }
 }
@@ -57,7 +59,8 @@ impl SimulateSettings {
     /// Checks the settings and returns the full simulation configuration.
     ///
     /// # Errors
-    /// [`JobError::Setting`] for no trajectory or more training trajectories than there are.
+    /// [`JobError::Setting`] for no trajectory, more training trajectories than there are, or a
+    /// wake motion or inflow at a fidelity that has none.
     pub fn check(&self) -> Result<SimulationConfig> {
         let n = self.n_trajectories;
         if n == 0 {
@@ -94,8 +97,28 @@ impl SimulateSettings {
             },
             ..VirtualWingConfig::default()
         };
-        wing.l2.ldvm.wake_motion = self.wake_motion;
-        wing.l2.inflow = self.inflow;
+        let refuse = |name: &str, value: String, expected: &str| JobError::Setting {
+            name: name.into(),
+            value,
+            expected: format!("{expected} (the fidelity is {:?})", self.fidelity),
+        };
+        if let Some(motion) = self.wake_motion {
+            if self.fidelity != Fidelity::L2 {
+                let value = format!("{motion:?}").to_lowercase();
+                return Err(refuse("wake", value, "applies to the L2 strips only"));
+            }
+            wing.l2.ldvm.wake_motion = motion;
+        }
+        if let Some(inflow) = self.inflow {
+            match self.fidelity {
+                Fidelity::L2 => wing.l2.inflow = inflow,
+                Fidelity::L3 => wing.l3.inflow = inflow,
+                Fidelity::L0 | Fidelity::L1 => {
+                    let value = format!("{inflow:?}").to_lowercase();
+                    return Err(refuse("inflow", value, "applies to L2 and L3 only"));
+                }
+            }
+        }
         Ok(SimulationConfig { wing, trajectories })
     }
 }
@@ -282,6 +305,56 @@ mod tests {
             .check()
             .unwrap_err();
             assert!(e.to_string().contains(name), "{e}");
+        }
+    }
+
+    #[test]
+    fn wake_and_inflow_reach_their_fidelity_or_are_refused() {
+        let with = |fidelity, wake_motion, inflow| {
+            SimulateSettings {
+                fidelity,
+                wake_motion,
+                inflow,
+                ..SimulateSettings::default()
+            }
+            .check()
+        };
+        let l3 = with(Fidelity::L3, None, None).unwrap();
+        assert_eq!(l3.wing.l3.inflow, Inflow::Momentum);
+        let still = with(Fidelity::L3, None, Some(Inflow::Still)).unwrap();
+        assert_eq!(still.wing.l3.inflow, Inflow::Still);
+        assert_eq!(still.wing.l2, l3.wing.l2);
+        let l2 = with(
+            Fidelity::L2,
+            Some(WakeMotion::Frozen),
+            Some(Inflow::Momentum),
+        )
+        .unwrap();
+        assert_eq!(l2.wing.l2.ldvm.wake_motion, WakeMotion::Frozen);
+        assert_eq!(l2.wing.l2.inflow, Inflow::Momentum);
+        assert_eq!(l2.wing.l3, l3.wing.l3);
+        for (fidelity, wake, inflow, said) in [
+            (
+                Fidelity::L3,
+                Some(WakeMotion::Frozen),
+                None,
+                "setting wake = frozen",
+            ),
+            (
+                Fidelity::L0,
+                Some(WakeMotion::Free),
+                None,
+                "setting wake = free",
+            ),
+            (
+                Fidelity::L1,
+                None,
+                Some(Inflow::Momentum),
+                "setting inflow = momentum",
+            ),
+        ] {
+            let e = with(fidelity, wake, inflow).unwrap_err().to_string();
+            assert!(e.contains(said) && e.contains("applies to"), "{e}");
         }
     }
 

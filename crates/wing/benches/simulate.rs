@@ -17,7 +17,7 @@ fn bench_simulate(c: &mut Criterion) {
         .expect("trajectory");
     let mut group = c.benchmark_group("simulate_trajectory");
     group.sample_size(10);
-    for fidelity in [Fidelity::L0, Fidelity::L1, Fidelity::L2] {
+    for fidelity in [Fidelity::L0, Fidelity::L1, Fidelity::L2, Fidelity::L3] {
         let cfg = VirtualWingConfig {
             fidelity,
             ..VirtualWingConfig::default()

@@ -40,12 +40,13 @@ pub enum Fidelity {
     L0,
     /// Unsteady low-order ([`crate::aero::unsteady`]).
     L1,
-    /// Vortex method strips ([`crate::vortex`]): the default generator (issue 3: L2 once it
-    /// meets the speed target; 548 trajectories in ≈ 64 s on 2 cores).
-    #[default]
+    /// Vortex method strips ([`crate::vortex`]): 2-D vortex sheets per strip with a free
+    /// wake (the default wing until issue 27; chaotic, with LEV bursts).
     L2,
     /// Unsteady vortex lattice of the whole plate with a prescribed shed wake
-    /// ([`crate::lattice`]; issue 27's 3-D candidate).
+    /// ([`crate::lattice`]): the default wing (issue 27: repeatable, not chaotic, no bursts;
+    /// docs/vortex-method.md, round 14).
+    #[default]
     L3,
 }
 
@@ -157,7 +158,7 @@ impl Default for VirtualWingConfig {
     fn default() -> Self {
         let wing = WingGeometry::default();
         Self {
-            fidelity: Fidelity::L2,
+            fidelity: Fidelity::L3,
             sensor_radius_m: wing.root_offset_m,
             wing,
             fluid: Fluid::default(),

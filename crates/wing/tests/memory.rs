@@ -12,8 +12,8 @@
 //! default wing adds the Dickinson chordwise coefficient C_T* and the chordwise Kirchhoff
 //! added-mass force −m_a ω_z(n + dω_z); with deviation, ω_z = α̇ + φ̇ sin ψ ≠ α̇. Neither is in
 //! the span of the 11 features (F_y and M_x are fit only to ≈ 1.0–1.15), so on the default wing
-//! only the lag target holds, on the default (measured-like) generator (L2: lag 0.114 cycle,
-//! ratio 1.16; L1: lag 0.139, ratio 1.36; on the hovering generator before it, L2 0.249 and 1.00,
+//! only the lag target holds, on the default (measured-like) generator (L3, the default wing:
+//! lag 0.289 cycle, ratio 1.24; L2: lag 0.114 cycle, ratio 1.16; L1: lag 0.139, ratio 1.36; on the hovering generator before it, L2 0.249 and 1.00,
 //! L1 0.157 and 1.11). L0 (≈ 0.72) and the ratios are pinned with a margin as regression
 //! guards, not as the issue-3 targets (see docs/virtual-wing.md).
 
@@ -43,6 +43,8 @@ const RATIO_PIN: f64 = 1.05;
 /// The same on L2, the default generator: measured 1.00 (the history model, linear in one
 /// cycle of past inputs, does not capture the vortex method's nonlinear memory).
 const RATIO_PIN_L2: f64 = 0.95;
+/// The same on L3, the default wing: measured 1.24.
+const RATIO_PIN_L3: f64 = 1.15;
 /// Past samples seen by the history model (25 Hz): covers one cycle for f ≥ 0.25 Hz.
 const LAGS: [usize; 20] = [
     0, 1, 2, 3, 4, 6, 8, 10, 13, 16, 20, 25, 30, 36, 43, 50, 60, 70, 85, 100,
@@ -333,11 +335,24 @@ fn flat_stroke_plane_meets_the_memory_targets() {
     assert!((0.1..=0.3).contains(&lag), "median lag {lag} cycle");
 }
 
-/// The default wing and generator (L2, measured: L2 QS 0.368, history model 0.316, lag 0.114
-/// cycle; on the hovering generator L0 QS 0.718, L2 QS 0.408, history 0.407, lag 0.249): the lag target holds; the quasi-steady fit of L0 and the ratio are
-/// pinned at their measured values with a margin (see the module docs).
+/// The default wing (L3, the vortex lattice) on the default generator (measured: L0 QS 0.271, L3
+/// QS 0.513, history model 0.414, ratio 1.24, lag 0.289 cycle): the lag target holds; the ratio
+/// is pinned with a margin, as a regression guard.
 #[test]
-fn default_generator_memory_evidence() {
+fn default_wing_memory_evidence() {
+    let m = memory(Set::Default, Chordwise::Full, Fidelity::L3);
+    let lag = m.median_lag_cycles;
+    assert!((0.1..=0.3).contains(&lag), "median lag {lag} cycle");
+    let ratio = m.qs_unsteady / m.history_unsteady;
+    assert!(ratio > RATIO_PIN_L3, "ratio {ratio}");
+}
+
+/// L2, the default wing until round 14 of docs/vortex-method.md, on the default generator
+/// (measured: L2 QS 0.368, history model 0.316, lag 0.114 cycle; on the hovering generator L0 QS
+/// 0.718, L2 QS 0.408, history 0.407, lag 0.249): the lag target holds; the quasi-steady fit of
+/// L0 and the ratio are pinned at their measured values with a margin (see the module docs).
+#[test]
+fn l2_default_generator_memory_evidence() {
     let m = memory(Set::Default, Chordwise::Full, Fidelity::L2);
     let lag = m.median_lag_cycles;
     assert!((0.1..=0.3).contains(&lag), "median lag {lag} cycle");

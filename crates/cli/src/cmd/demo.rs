@@ -48,7 +48,8 @@ pub struct DemoArgs {
     #[arg(long)]
     particles: Option<usize>,
     /// Override the virtual wing's aerodynamic fidelity: l0 (quasi-steady), l1 (unsteady
-    /// low-order), l2 (vortex strips, the default wing of the demo and of `simulate`).
+    /// low-order), l2 (vortex strips), l3 (vortex lattice, the default wing of the demo and of
+    /// `simulate`).
     #[arg(long, value_name = "LEVEL")]
     fidelity: Option<String>,
     /// Override the fraction of the training trajectories held out for validation (default

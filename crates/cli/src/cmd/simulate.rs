@@ -26,8 +26,8 @@ pub struct SimulateArgs {
     #[arg(long, value_name = "S", default_value_t = 0)]
     seed: u64,
     /// Aerodynamic fidelity: l0 (quasi-steady), l1 (unsteady low-order), l2 (vortex strips), l3
-    /// (vortex lattice of the whole plate with a prescribed wake).
-    #[arg(long, value_name = "LEVEL", default_value = "l2")]
+    /// (vortex lattice of the whole plate with a prescribed wake, the default wing).
+    #[arg(long, value_name = "LEVEL", default_value = "l3")]
     fidelity: String,
     /// Output dataset file (.npz).
     #[arg(long, value_name = "FILE")]
@@ -42,13 +42,15 @@ pub struct SimulateArgs {
     #[arg(long)]
     flat: bool,
     /// L2 wake: free (vortex dynamics, the default) or frozen (vortices stay where shed, in
-    /// the moving fluid; docs/vortex-method.md, round 12).
-    #[arg(long, value_name = "MOTION", default_value = "free")]
-    wake: String,
-    /// L2 induced inflow: still (the default), momentum (blade-element momentum theory from
-    /// each strip's recent lift) or uniform:K (the fluid sinks at K·U_ref).
-    #[arg(long, value_name = "INFLOW", default_value = "still")]
-    inflow: String,
+    /// the moving fluid; docs/vortex-method.md, round 12). Refused at other fidelities.
+    #[arg(long, value_name = "MOTION")]
+    wake: Option<String>,
+    /// Induced inflow of L2 and L3: still, momentum (momentum theory from the recent lift: of
+    /// each strip at L2, of the whole wing at L3) or uniform:K (the fluid sinks at K·U_ref at
+    /// L2, at K × the reference point's recent mean speed at L3). Default: still at L2,
+    /// momentum at L3. Refused at L0 and L1.
+    #[arg(long, value_name = "INFLOW")]
+    inflow: Option<String>,
     /// Hide the progress bar.
     #[arg(long)]
     quiet: bool,
@@ -66,8 +68,14 @@ pub fn run(args: SimulateArgs) -> anyhow::Result<()> {
         fidelity,
         noise_free: args.noise_free,
         flat: args.flat,
-        wake_motion: args.wake.parse().context("parsing --wake")?,
-        inflow: args.inflow.parse().context("parsing --inflow")?,
+        wake_motion: args
+            .wake
+            .map(|w| w.parse().context("parsing --wake"))
+            .transpose()?,
+        inflow: args
+            .inflow
+            .map(|i| i.parse().context("parsing --inflow"))
+            .transpose()?,
     };
     let cfg = settings.check()?;
     let bars = Bars::new();

@@ -78,7 +78,7 @@ def dataset_from_arrays(
 def simulate(
     n: int = 548,
     seed: int = 0,
-    fidelity: str = "l2",
+    fidelity: str = "l3",
     n_train: Optional[int] = None,
     noise_free: bool = False,
     flat: bool = False,
@@ -86,14 +86,15 @@ def simulate(
 ) -> "_native.Dataset":
     """Simulates the virtual wing on ``n`` generated trajectories (``flapssm simulate``):
     the same seed gives the same dataset as the CLI. ``fidelity``: ``l0`` quasi-steady,
-    ``l1`` unsteady low-order, ``l2`` vortex method. ``progress(stage, position, total)``."""
+    ``l1`` unsteady low-order, ``l2`` vortex strips, ``l3`` vortex lattice (the default wing).
+    ``progress(stage, position, total)``."""
     return _native.simulate(int(n), int(seed), fidelity, n_train, noise_free, flat, progress)
 
 
 def simulate_angles(
     euler_rad: Any,
     seed: int = 0,
-    fidelity: str = "l2",
+    fidelity: str = "l3",
     n_train: Optional[int] = None,
     noise_free: bool = False,
     progress: Optional[Progress] = None,
