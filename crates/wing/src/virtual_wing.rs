@@ -624,7 +624,7 @@ impl Run<'_> {
 mod tests {
     use super::*;
 
-    /// Each of the three checks names the field at fault.
+    /// Each check names the field at fault.
     #[test]
     fn bad_parameters_are_named() {
         assert!(VirtualWingConfig::default().check().is_ok());
@@ -651,12 +651,24 @@ mod tests {
                 ..
             }))
         ));
+        // The L2 and L3 settings are checked at their own fidelity.
         let mut cfg = VirtualWingConfig::default();
         cfg.l2.max_step_chords = 0.0;
+        assert!(cfg.check().is_ok());
+        cfg.fidelity = Fidelity::L2;
         assert!(matches!(
             cfg.check(),
             Err(SimulateError::InvalidL2(VortexError::InvalidParameter {
                 name: "max_step_chords",
+                ..
+            }))
+        ));
+        let mut cfg = VirtualWingConfig::default();
+        cfg.l3.step_chords = 0.0;
+        assert!(matches!(
+            cfg.check(),
+            Err(SimulateError::InvalidL3(LatticeError::InvalidParameter {
+                name: "step_chords",
                 ..
             }))
         ));
