@@ -104,8 +104,11 @@ impl SimulateSettings {
         };
         if let Some(motion) = self.wake_motion {
             if self.fidelity != Fidelity::L2 {
-                let value = format!("{motion:?}").to_lowercase();
-                return Err(refuse("wake", value, "applies to the L2 strips only"));
+                return Err(refuse(
+                    "wake",
+                    motion.to_string(),
+                    "applies to the L2 strips only",
+                ));
             }
             wing.l2.ldvm.wake_motion = motion;
         }
@@ -114,7 +117,7 @@ impl SimulateSettings {
                 Fidelity::L2 => wing.l2.inflow = inflow,
                 Fidelity::L3 => wing.l3.inflow = inflow,
                 Fidelity::L0 | Fidelity::L1 => {
-                    let value = format!("{inflow:?}").to_lowercase();
+                    let value = inflow.to_string();
                     return Err(refuse("inflow", value, "applies to L2 and L3 only"));
                 }
             }
@@ -351,6 +354,12 @@ mod tests {
                 None,
                 Some(Inflow::Momentum),
                 "setting inflow = momentum",
+            ),
+            (
+                Fidelity::L0,
+                None,
+                Some(Inflow::Uniform { ratio: 0.5 }),
+                "setting inflow = uniform:0.5",
             ),
         ] {
             let e = with(fidelity, wake, inflow).unwrap_err().to_string();

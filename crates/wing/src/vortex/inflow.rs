@@ -54,6 +54,17 @@ impl std::str::FromStr for Inflow {
     }
 }
 
+/// The name [`std::str::FromStr`] reads: `still`, `momentum` or `uniform:K`.
+impl std::fmt::Display for Inflow {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::Still => f.write_str("still"),
+            Self::Momentum => f.write_str("momentum"),
+            Self::Uniform { ratio } => write!(f, "uniform:{ratio}"),
+        }
+    }
+}
+
 /// Reversals closer together than this (chords of horizontal travel) are not half-strokes.
 const MIN_HALF_STROKE_CHORDS: f64 = 0.5;
 
@@ -199,6 +210,26 @@ mod tests {
         for bad in ["uniform:-1", "uniform:x", "up"] {
             let e = bad.parse::<Inflow>().unwrap_err().to_string();
             assert!(e.contains(bad) && e.contains("momentum"), "{e}");
+        }
+        // Display writes the name FromStr reads.
+        for inflow in [
+            Inflow::Still,
+            Inflow::Momentum,
+            Inflow::Uniform { ratio: 0.25 },
+        ] {
+            assert_eq!(inflow.to_string().parse::<Inflow>().unwrap(), inflow);
+        }
+        for motion in [
+            crate::vortex::WakeMotion::Free,
+            crate::vortex::WakeMotion::Frozen,
+        ] {
+            assert_eq!(
+                motion
+                    .to_string()
+                    .parse::<crate::vortex::WakeMotion>()
+                    .unwrap(),
+                motion
+            );
         }
     }
 }

@@ -168,6 +168,16 @@ pub enum WakeMotion {
     Frozen,
 }
 
+/// The name [`std::str::FromStr`] reads: `free` or `frozen`.
+impl std::fmt::Display for WakeMotion {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            Self::Free => "free",
+            Self::Frozen => "frozen",
+        })
+    }
+}
+
 impl std::str::FromStr for WakeMotion {
     type Err = VortexError;
     /// `free` or `frozen`.
