@@ -106,8 +106,6 @@ pub fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
 mod tests {
     use super::*;
 
-    /// An infinite line (a long segment) induces Γ/(2πh) around itself; a finite one
-    /// Γ/(4πh)(cos θ1 − cos θ2); the core only matters within a few r_c.
     /// The velocity of one segment at one point.
     fn at(x: [f64; 3], p1: [f64; 3], p2: [f64; 3], gamma: f64, core: f64) -> [f64; 3] {
         let points = Points {
