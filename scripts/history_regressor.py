@@ -157,7 +157,7 @@ def load(path):
     try:
         d = np.load(path, allow_pickle=False)
         u, y, train = d["u"], d["y"], d["is_train"].astype(bool)
-        names = list(d["output_names"])
+        names = [str(n) for n in d["output_names"]]
     except (OSError, KeyError, ValueError) as e:
         sys.exit(f"error: {path}: {e}")
     if u.ndim != 3 or u.shape[1] <= START or y.shape[:2] != u.shape[:2]:

@@ -39,8 +39,8 @@ def load(path):
             chord=float(meta["wing"]["chord_m"]),
             u_ref=float(meta["settings"]["mean_u_ref_m_s"]),
             fidelity=str(meta["settings"]["fidelity"]).upper(),
-            names=list(d["output_names"]),
-            units=list(d["output_units"]),
+            names=[str(n) for n in d["output_names"]],
+            units=[str(n) for n in d["output_units"]],
         )
     except (OSError, KeyError, ValueError, TypeError) as e:
         sys.exit(f"error: {path}: {e}")
