@@ -46,21 +46,18 @@ def load(path):
         sys.exit(f"error: {path}: {e}")
 
 
-def spectrum(r, dt):
-    """Frequencies (Hz) and the mean Hann-windowed periodogram over axis 0 of r (traj, time, ch)."""
-    r = r - r.mean(axis=1, keepdims=True)
-    w = np.hanning(r.shape[1])[None, :, None]
-    p = np.abs(np.fft.rfft(r * w, axis=1)) ** 2
-    return np.fft.rfftfreq(r.shape[1], dt), p.mean(axis=0)
+def periodogram(x, dt):
+    """Frequencies (Hz) and the Hann-windowed periodogram of x (traj, time, ch) along time; x is
+    expected with its mean over time removed."""
+    w = np.hanning(x.shape[1])[None, :, None]
+    return np.fft.rfftfreq(x.shape[1], dt), np.abs(np.fft.rfft(x * w, axis=1)) ** 2
 
 
 def stroke_frequency(euler, dt):
     """Median over trajectories of the stroke angle's spectral peak (Hz)."""
-    stroke = euler[:, START:, 0]
-    stroke = (stroke - stroke.mean(axis=1, keepdims=True)) * np.hanning(stroke.shape[1])
-    f = np.fft.rfftfreq(stroke.shape[1], dt)
-    peak = np.argmax(np.abs(np.fft.rfft(stroke, axis=1))[:, 1:], axis=1) + 1
-    return float(np.median(f[peak]))
+    stroke = euler[:, START:, :1]
+    f, p = periodogram(stroke - stroke.mean(axis=1, keepdims=True), dt)
+    return float(np.median(f[np.argmax(p[:, 1:, 0], axis=1) + 1]))
 
 
 def main():
@@ -80,11 +77,12 @@ def main():
         if d["y"].shape != ref["y"].shape or d["names"] != ref["names"] or not np.allclose(d["euler"], ref["euler"]):
             sys.exit(f"error: {path}: not the same trajectories and channels as {a.reference}")
         r = (d["y"] - ref["y"])[:, START:, :]
-        f, psd = spectrum(r, d["dt"])
+        rc = r - r.mean(axis=1, keepdims=True)
+        f, p_traj = periodogram(rc, d["dt"])
+        psd = p_traj.mean(axis=0)
         total = psd[1:].sum(axis=0)
         above_1 = psd[f > 1.0].sum(axis=0) / total
         above_c = psd[f > f_c].sum(axis=0) / total
-        rc = r - r.mean(axis=1, keepdims=True)
         lag1 = (rc[:, 1:] * rc[:, :-1]).sum(axis=(0, 1)) / (rc**2).sum(axis=(0, 1))
         rms = np.sqrt((r**2).mean(axis=(0, 1)))
         print(f"\n{path} ({d['fidelity']} - {ref['fidelity']}):")
