@@ -219,17 +219,5 @@ mod tests {
         ] {
             assert_eq!(inflow.to_string().parse::<Inflow>().unwrap(), inflow);
         }
-        for motion in [
-            crate::vortex::WakeMotion::Free,
-            crate::vortex::WakeMotion::Frozen,
-        ] {
-            assert_eq!(
-                motion
-                    .to_string()
-                    .parse::<crate::vortex::WakeMotion>()
-                    .unwrap(),
-                motion
-            );
-        }
     }
 }

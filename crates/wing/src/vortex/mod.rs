@@ -391,3 +391,18 @@ impl LdvmParams {
         Ok(())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Display writes the name FromStr reads; other names are refused by name.
+    #[test]
+    fn wake_motion_names_round_trip() {
+        for motion in [WakeMotion::Free, WakeMotion::Frozen] {
+            assert_eq!(motion.to_string().parse::<WakeMotion>().unwrap(), motion);
+        }
+        let e = "rolled".parse::<WakeMotion>().unwrap_err().to_string();
+        assert!(e.contains("rolled") && e.contains("free or frozen"), "{e}");
+    }
+}
