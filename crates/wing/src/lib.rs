@@ -15,5 +15,6 @@ pub mod kinematics;
 pub mod lattice;
 pub mod sensor;
 pub mod trajectories;
+mod vec3;
 pub mod virtual_wing;
 pub mod vortex;

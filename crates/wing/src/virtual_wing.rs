@@ -22,6 +22,7 @@ use crate::kinematics::{EulerState, WingKinematics, rotation_global_from_wing};
 use crate::lattice::{LatticeError, VortexLatticeParams, VortexLatticeWing};
 use crate::sensor::{DatasetSensorErrors, SensorConfig, measure};
 use crate::trajectories::{GeneratorConfig, TrajectoryError, TrajectorySpec};
+use crate::vec3::{add, cross};
 use crate::vortex::{StripLdvmFactory, StripLdvmParams, VortexError};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -464,18 +465,6 @@ impl VirtualWing {
             family: family.to_string(),
         })
     }
-}
-
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
-fn add(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
 }
 
 /// Seed offset of the sensor streams (independent of the trajectory generator's streams).

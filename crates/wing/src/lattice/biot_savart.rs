@@ -1,6 +1,8 @@
 //! The velocity induced by a straight vortex segment (Biot–Savart), with a smoothed core, at
 //! many points at once.
 
+use crate::vec3::{cross, dot, sub};
+
 /// 1/(4π).
 const INV_4PI: f64 = 0.25 / std::f64::consts::PI;
 
@@ -78,28 +80,6 @@ pub(crate) fn add_segment_velocity(
         oy[k] += f * c[1];
         oz[k] += f * c[2];
     }
-}
-
-/// a − b.
-#[inline]
-pub fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-/// a · b.
-#[inline]
-pub fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-/// a × b.
-#[inline]
-pub fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
 }
 
 #[cfg(test)]

@@ -1,12 +1,13 @@
 //! The unsteady vortex-lattice wing: bound rings on the plate, a shed wake, loads from the
 //! unsteady Bernoulli equation and the leading-edge suction (module docs of [`super`]).
 
-use super::biot_savart::{Points, add_segment_velocity, cross, dot, sub};
+use super::biot_savart::{Points, add_segment_velocity};
 use super::inflow::{WingInflow, slipstream_speed};
 use super::wake::Wake;
 use super::{LatticeError, VortexLatticeParams};
 use crate::dataset::{Fluid, WingGeometry};
 use crate::kinematics::{EulerState, Mat3, WingKinematics, rotation_global_from_wing};
+use crate::vec3::{cross, midpoint, norm, sub};
 use faer::linalg::solvers::DenseSolveCore;
 
 /// The vortex-lattice model of one rigid plate (reuse it: [`Self::loads_into`] resets it).
@@ -367,7 +368,7 @@ impl VortexLatticeWing {
                 // Spanwise bound filament at the quarter panel: ρ Γ_net Q_y Δs along +x.
                 let p = [0.0, self.ring_y[i], z_mid];
                 let wake = if i > 0 {
-                    mean(wake_at(i - 1, j), wake_at(i, j))
+                    midpoint(wake_at(i - 1, j), wake_at(i, j))
                 } else {
                     wake_at(i, j)
                 };
@@ -409,7 +410,7 @@ impl VortexLatticeWing {
                 let right = if j < ns { gamma(i, j) } else { 0.0 };
                 let left = if j > 0 { gamma(i, j - 1) } else { 0.0 };
                 let wake = match (j > 0, j < ns) {
-                    (true, true) => mean(wake_at(i, j - 1), wake_at(i, j)),
+                    (true, true) => midpoint(wake_at(i, j - 1), wake_at(i, j)),
                     (true, false) => wake_at(i, j - 1),
                     _ => wake_at(i, j),
                 };
@@ -442,18 +443,6 @@ fn relative(fluid: [f64; 3], omega: [f64; 3], wake: [f64; 3], p: [f64; 3]) -> [f
         fluid[1] + wake[1] - v[1],
         fluid[2] + wake[2] - v[2],
     ]
-}
-
-fn mean(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        0.5 * (a[0] + b[0]),
-        0.5 * (a[1] + b[1]),
-        0.5 * (a[2] + b[2]),
-    ]
-}
-
-fn norm(a: [f64; 3]) -> f64 {
-    dot(a, a).sqrt()
 }
 
 fn dot_slice(a: &[f64], b: &[f64]) -> f64 {
