@@ -1,6 +1,5 @@
 //! `flapssm demo`: simulate, fit the LRQSM, train the PR-SSM, evaluate and report, resumably.
 
-use flapssm_prssm::Precision;
 use flapssm_prssm::train::Preset;
 use std::path::PathBuf;
 
@@ -11,7 +10,7 @@ use flapssm_jobs::demo::{DEMO_FILES, DemoConfig, run_demo};
 use flapssm_jobs::evaluate::EVALUATION_FILES;
 use flapssm_jobs::files::check_output_dir;
 
-use crate::cmd::choices::{BestByArg, InducingInitArg, ObjectiveArg, SourceArg};
+use crate::cmd::choices::{BestByArg, ObjectiveArg, SourceArg, TrainingChoices};
 use crate::progress::{Bars, stop_flag};
 
 /// Run the whole pipeline on a simulated wing.
@@ -64,27 +63,8 @@ pub struct DemoArgs {
     /// authors' objective and shared noise draws).
     #[arg(long, value_enum, value_name = "FORM")]
     objective: Option<ObjectiveArg>,
-    /// Override how the inducing inputs and q(u) means start: uniform (the published code)
-    /// or kmeans of the training inputs.
-    #[arg(long, value_enum, value_name = "RULE")]
-    inducing_init: Option<InducingInitArg>,
-    /// Early stopping: end training when N evaluated epochs in a row bring no new best model.
-    #[arg(long, value_name = "N", value_parser = super::positive::<u64>)]
-    patience: Option<u64>,
-    /// Override the arithmetic of the ELBO's large products: f64 (the default) or mixed (those
-    /// products in f32; docs/training.md).
-    #[arg(long)]
-    precision: Option<Precision>,
-    /// Windows (sequences) per parallel task of the ELBO: a minibatch of B windows keeps at
-    /// most ceil(B / N) threads busy (default 2: the default's minibatches of 4 fill 2 cores;
-    /// with --full the preset's, 4 for batch 16); results depend on the thread count not at
-    /// all, on N only in the last bits (docs/training.md).
-    #[arg(long, value_name = "N", value_parser = super::positive::<usize>)]
-    windows_per_task: Option<usize>,
-    /// Override the initial lengthscale of every GP input, in standardized units (published:
-    /// 2; docs/training.md, "Time to quality").
-    #[arg(long, value_name = "L")]
-    lengthscale_init: Option<f64>,
+    #[command(flatten)]
+    training: TrainingChoices,
     /// Override where the trajectories come from: generator (the default) or paper (the
     /// paper's measured trajectories, the default with --full; the first --trajectories).
     #[arg(long, value_enum, value_name = "SOURCE")]
@@ -137,21 +117,7 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
     if let Some(o) = args.objective {
         cfg.training.objective = o.into();
     }
-    if let Some(i) = args.inducing_init {
-        cfg.training.inducing_init = Some(i.into());
-    }
-    if args.patience.is_some() {
-        cfg.training.patience = args.patience;
-    }
-    if args.precision.is_some() {
-        cfg.training.precision = args.precision;
-    }
-    if args.windows_per_task.is_some() {
-        cfg.training.windows_per_task = args.windows_per_task;
-    }
-    if args.lengthscale_init.is_some() {
-        cfg.training.lengthscale_init = args.lengthscale_init;
-    }
+    args.training.apply(&mut cfg.training);
     let stop = stop_flag()?;
     let bars = Bars::new();
     let s = run_demo(&args.out, &cfg, &bars, Some(&stop))

@@ -1,6 +1,5 @@
 //! `flapssm sweep run|merge`: one PR-SSM configuration per process, and the merged table.
 
-use flapssm_prssm::Precision;
 use std::path::PathBuf;
 
 use anyhow::Context;
@@ -14,14 +13,14 @@ use flapssm_jobs::train::TrainingOptions;
 use flapssm_prssm::train::fit::Preset;
 use flapssm_wing::dataset::Dataset;
 
-use crate::cmd::choices::InducingInitArg;
+use crate::cmd::choices::TrainingChoices;
 use crate::progress::{Bars, stop_flag};
 
 /// Sweep subcommands.
 #[derive(Subcommand)]
 pub enum SweepCommand {
     /// Train and evaluate one configuration, write its result file.
-    Run(RunArgs),
+    Run(Box<RunArgs>),
     /// Merge result files into a table (CSV; .json and .png next to it).
     Merge(MergeArgs),
 }
@@ -72,22 +71,8 @@ pub struct RunArgs {
     /// Fraction of the training trajectories held out for best-model selection.
     #[arg(long, default_value_t = 0.1)]
     val_fraction: f64,
-    /// How the inducing inputs and q(u) means start: uniform (the published code) or kmeans.
-    #[arg(long, value_enum)]
-    inducing_init: Option<InducingInitArg>,
-    /// Early stopping: end training when N evaluated epochs in a row bring no new best model.
-    #[arg(long, value_name = "N", value_parser = super::positive::<u64>)]
-    patience: Option<u64>,
-    /// Arithmetic of the ELBO's large products: f64 (the reference) or mixed (those products
-    /// in f32, everything else in f64; docs/training.md). Default: the preset's (f64, and
-    /// mixed for paper-fast).
-    #[arg(long)]
-    precision: Option<Precision>,
-    /// Windows (sequences) per parallel task of the ELBO: a minibatch of B windows keeps at
-    /// most ceil(B / N) threads busy (default 4: batch 16 fills 4 cores); results depend on the
-    /// thread count not at all, on N only in the last bits (docs/training.md).
-    #[arg(long, value_name = "N", value_parser = super::positive::<usize>)]
-    windows_per_task: Option<usize>,
+    #[command(flatten)]
+    training: TrainingChoices,
     /// Particles of the evaluation predictions.
     #[arg(long, default_value_t = 30)]
     eval_particles: usize,
@@ -120,7 +105,7 @@ pub struct MergeArgs {
 /// Runs `flapssm sweep`.
 pub fn run(cmd: SweepCommand) -> anyhow::Result<()> {
     match cmd {
-        SweepCommand::Run(a) => run_one(a),
+        SweepCommand::Run(a) => run_one(*a),
         SweepCommand::Merge(a) => merge(a),
     }
 }
@@ -130,7 +115,7 @@ fn run_one(a: RunArgs) -> anyhow::Result<()> {
     check_outputs(&[&a.out, &checkpoint], &[&a.dataset])?;
     let ds = Dataset::load(&a.dataset)
         .with_context(|| format!("loading dataset {}", a.dataset.display()))?;
-    let training = TrainingOptions {
+    let mut training = TrainingOptions {
         preset: a.preset,
         dx: a.dx,
         inducing: a.inducing,
@@ -145,13 +130,10 @@ fn run_one(a: RunArgs) -> anyhow::Result<()> {
         val_fraction: a.val_fraction,
         best_by: Default::default(),
         objective: Default::default(),
-        inducing_init: a.inducing_init.map(Into::into),
-        patience: a.patience,
-        precision: a.precision,
-        windows_per_task: a.windows_per_task,
-        lengthscale_init: None,
         checkpoint_every: a.checkpoint_every,
+        ..TrainingOptions::default()
     };
+    a.training.apply(&mut training);
     let plan = SweepSettings {
         kind: a.kind,
         value: a.value,

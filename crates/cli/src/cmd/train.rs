@@ -1,6 +1,5 @@
 //! `flapssm train DATASET --out MODEL`: fit a PR-SSM to a flapssm dataset.
 
-use flapssm_prssm::Precision;
 use std::path::PathBuf;
 
 use anyhow::{Context, bail};
@@ -11,7 +10,7 @@ use flapssm_prssm::train::LrSchedule;
 use flapssm_prssm::train::fit::Preset;
 use flapssm_wing::dataset::Dataset;
 
-use crate::cmd::choices::{BestByArg, InducingInitArg, ObjectiveArg};
+use crate::cmd::choices::{BestByArg, ObjectiveArg, TrainingChoices};
 use crate::progress::{Bars, stop_flag};
 
 /// Train a PR-SSM (negative-ELBO minimization with Adam).
@@ -67,27 +66,8 @@ pub struct TrainArgs {
     /// objective and shared noise draws, to re-run their exact training).
     #[arg(long, value_enum, default_value = "standard")]
     objective: ObjectiveArg,
-    /// How the inducing inputs and q(u) means start: uniform (the published code) or kmeans
-    /// of the training inputs (default: the preset's).
-    #[arg(long, value_enum)]
-    inducing_init: Option<InducingInitArg>,
-    /// Early stopping: end the run when N evaluated epochs in a row bring no new best model.
-    #[arg(long, value_name = "N", value_parser = super::positive::<u64>)]
-    patience: Option<u64>,
-    /// Arithmetic of the ELBO's large products: f64 (the reference) or mixed (those products
-    /// in f32, everything else in f64; docs/training.md). Default: the preset's (f64, and
-    /// mixed for paper-fast).
-    #[arg(long)]
-    precision: Option<Precision>,
-    /// Windows (sequences) per parallel task of the ELBO: a minibatch of B windows keeps at
-    /// most ceil(B / N) threads busy (default 4: batch 16 fills 4 cores); results depend on the
-    /// thread count not at all, on N only in the last bits (docs/training.md).
-    #[arg(long, value_name = "N", value_parser = super::positive::<usize>)]
-    windows_per_task: Option<usize>,
-    /// Initial lengthscale of every GP input, in standardized units (default: the preset's,
-    /// 2 as published).
-    #[arg(long, value_name = "L")]
-    lengthscale_init: Option<f64>,
+    #[command(flatten)]
+    training: TrainingChoices,
     /// Write a checkpoint every N epochs (0: only on Ctrl-C).
     #[arg(long, default_value_t = 10)]
     checkpoint_every: u64,
@@ -127,7 +107,7 @@ fn parse_schedule(s: &str) -> anyhow::Result<LrSchedule> {
 /// Runs `flapssm train`.
 pub fn run(args: TrainArgs) -> anyhow::Result<()> {
     let schedule = args.schedule.as_deref().map(parse_schedule).transpose()?;
-    let plan = TrainingOptions {
+    let mut plan = TrainingOptions {
         preset: args.preset,
         dx: args.dx,
         inducing: args.inducing,
@@ -142,14 +122,11 @@ pub fn run(args: TrainArgs) -> anyhow::Result<()> {
         val_fraction: args.val_fraction,
         best_by: args.best_by.into(),
         objective: args.objective.into(),
-        inducing_init: args.inducing_init.map(Into::into),
-        patience: args.patience,
-        precision: args.precision,
-        windows_per_task: args.windows_per_task,
-        lengthscale_init: args.lengthscale_init,
         checkpoint_every: args.checkpoint_every,
-    }
-    .check()?;
+        ..TrainingOptions::default()
+    };
+    args.training.apply(&mut plan);
+    let plan = plan.check()?;
     let files = TrainFiles::beside(&args.out, args.checkpoint.clone());
     flapssm_jobs::files::check_outputs(
         &[&files.model, &files.last, &files.checkpoint, &files.curve],
