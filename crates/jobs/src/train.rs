@@ -66,7 +66,8 @@ pub struct TrainingOptions {
     /// windows keeps at most `⌈B / n⌉` threads busy.
     #[serde(default)]
     pub windows_per_task: Option<usize>,
-    /// Initial lengthscale of every GP input, standardized units (the preset's 2 when `None`).
+    /// Initial lengthscale of every GP input, standardized units (the preset's when `None`: 2
+    /// as published, 10 for paper-fast).
     #[serde(default)]
     pub lengthscale_init: Option<f64>,
     /// Checkpoint every this many epochs (0: only when interrupted).
