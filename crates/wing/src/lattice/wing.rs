@@ -7,7 +7,7 @@ use super::wake::Wake;
 use super::{LatticeError, VortexLatticeParams};
 use crate::dataset::{Fluid, WingGeometry};
 use crate::kinematics::{EulerState, Mat3, WingKinematics, rotation_global_from_wing};
-use crate::vec3::{cross, midpoint, norm, sub};
+use crate::vec3::{add, cross, midpoint, norm, sub};
 use faer::linalg::solvers::DenseSolveCore;
 
 /// The vortex-lattice model of one rigid plate (reuse it: [`Self::loads_into`] resets it).
@@ -437,12 +437,7 @@ impl VortexLatticeWing {
 /// The fluid's velocity relative to the plate point `p` (wing frame, m/s): the fluid's own
 /// motion `fluid` plus the wake's `wake`, less the point's ω × p.
 fn relative(fluid: [f64; 3], omega: [f64; 3], wake: [f64; 3], p: [f64; 3]) -> [f64; 3] {
-    let v = cross(omega, p);
-    [
-        fluid[0] + wake[0] - v[0],
-        fluid[1] + wake[1] - v[1],
-        fluid[2] + wake[2] - v[2],
-    ]
+    sub(add(fluid, wake), cross(omega, p))
 }
 
 fn dot_slice(a: &[f64], b: &[f64]) -> f64 {
