@@ -121,15 +121,11 @@ fn run_one(a: RunArgs) -> anyhow::Result<()> {
         inducing: a.inducing,
         particles: a.particles,
         epochs: a.epochs,
-        iterations: None,
         batch: a.batch,
         lr: a.lr,
-        schedule: None,
         eval_every: a.eval_every,
         seed: a.seed,
         val_fraction: a.val_fraction,
-        best_by: Default::default(),
-        objective: Default::default(),
         checkpoint_every: a.checkpoint_every,
         ..TrainingOptions::default()
     };
