@@ -14,6 +14,8 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::linalg::F32_OPERAND_FLOOR;
+
 /// Which stationary kernel the transition GP uses (one kernel shared by all latent dims).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -87,6 +89,38 @@ pub fn exp(x: f64) -> f64 {
     let p = 1.0 + r2.mul_add(q, r);
     let scale = f64::from_bits((k.wrapping_add(1023) as u64) << 52);
     if xc < FLUSH { 0.0 } else { p * scale }
+}
+
+/// `eˣ` in `f32`, branch-free (vectorizable) for `x ≤ 0` as the kernels need: `x = k ln2 + r`,
+/// `k = round(x / ln2)`, `|r| ≤ ln2/2` (Cody–Waite), `eʳ` by its degree-7 Taylor polynomial in
+/// Horner form with fused multiply-adds (truncation `< 6·10⁻⁹`; with `f32` rounding within
+/// `2·10⁻⁷` of `eˣ`, tested), scaled by `2ᵏ` through the exponent bits. `x < −87` is taken as
+/// `−87` (`e⁻⁸⁷ ≈ 1.6·10⁻³⁸`, a normal `f32`); NaN propagates.
+#[inline(always)]
+pub(crate) fn exp_f32(x: f32) -> f32 {
+    // ln2 = LN2_HI + LN2_LO: `k · LN2_HI` is exact for |k| < 2¹⁵.
+    const LN2_HI: f32 = 0.693_359_4;
+    const LN2_LO: f32 = -2.121_944_4e-4;
+    // 1.5·2²³: adding it rounds to an integer, which is then the low bits of the sum.
+    const SHIFT: f32 = 12_582_912.0;
+    const C: [f32; 6] = [
+        1.0 / 2.0,
+        1.0 / 6.0,
+        1.0 / 24.0,
+        1.0 / 120.0,
+        1.0 / 720.0,
+        1.0 / 5040.0,
+    ];
+    let x = if x < -87.0 { -87.0 } else { x };
+    let t = x.mul_add(std::f32::consts::LOG2_E, SHIFT);
+    let kf = t - SHIFT;
+    let k = (t.to_bits() as i32).wrapping_sub(SHIFT.to_bits() as i32);
+    let r = kf.mul_add(-LN2_LO, kf.mul_add(-LN2_HI, x));
+    let q = C[5].mul_add(r, C[4]).mul_add(r, C[3]).mul_add(r, C[2]);
+    let q = q.mul_add(r, C[1]).mul_add(r, C[0]).mul_add(r, 1.0);
+    let p = q.mul_add(r, 1.0);
+    let scale = f32::from_bits((k.wrapping_add(127) as u32) << 23);
+    p * scale
 }
 
 /// Scales a row-major `N × D` point set by `1/ℓ` into a column-major `D × N` slice
@@ -187,6 +221,45 @@ pub(crate) fn cross_cov_grouped_values(
         group_sq_dist(zt, m_n, d, shared_from, xg, tau_shared, kg);
         // Over the whole group: one vector loop without per-column scalar tails.
         apply_shape_values(kind, variance, matern_tau_jitter, kg);
+    }
+}
+
+/// [`cross_cov_grouped`] with the shape in `f32`, for the products of mixed precision
+/// ([`crate::precision`]): `τ` in `f64` into `tau` (`M × N`), then `k32 = σ_f² g(τ)` by
+/// [`exp_f32`] and the `f32` square root, as product operands (values below
+/// [`F32_OPERAND_FLOOR`] become zero), and, if `kd` is given, `σ_f² g'(τ)` widened into it.
+/// Within a few `f32` roundings of the `f64` values; twice the lanes of the `f64` shape.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn cross_cov_grouped_f32(
+    kind: KernelKind,
+    variance: f64,
+    matern_tau_jitter: f64,
+    zt: &[f64],
+    xs: &[f64],
+    d: usize,
+    (shared_from, group): (usize, usize),
+    tau: &mut [f64],
+    k32: &mut [f32],
+    mut kd: Option<&mut [f64]>,
+    tau_shared: &mut [f64],
+) {
+    let m_n = zt.len() / d;
+    let tau_shared = &mut tau_shared[..m_n];
+    let n = xs.len() / d;
+    let (tau, k32) = (&mut tau[..m_n * n], &mut k32[..m_n * n]);
+    for (g, xg) in xs.chunks(d * group).enumerate() {
+        let cols = g * m_n * group..((g + 1) * m_n * group).min(m_n * n);
+        let tg = &mut tau[cols.clone()];
+        group_sq_dist(zt, m_n, d, shared_from, xg, tau_shared, tg);
+        let kdg = kd.as_deref_mut().map(|kd| &mut kd[cols.clone()]);
+        apply_shape_f32(
+            kind,
+            variance as f32,
+            matern_tau_jitter,
+            tg,
+            &mut k32[cols],
+            kdg,
+        );
     }
 }
 
@@ -296,6 +369,77 @@ fn apply_shape_values(kind: KernelKind, variance: f64, jitter: f64, k: &mut [f64
             }
         }
     }
+}
+
+/// `k[i] = σ_f² g(τ[i])` in `f32`, as a product operand (below [`F32_OPERAND_FLOOR`]: zero),
+/// and `kd[i] = σ_f² g'(τ[i])` if given: `g = c(p) e^{x(p)}` and `g' = c' e^{x(p)}` with
+/// `p = √(3(τ + δ))`, `x = −p`, `c = 1 + p`, `c' = −3/2` (Matern-3/2) or `p = −τ/2`, `x = p`,
+/// `c = 1`, `c' = −1/2` (squared exponential). `τ` is overwritten (its bytes hold the `f32`
+/// values `σ_f² e^{x}` for `kd`).
+#[inline]
+fn apply_shape_f32(
+    kind: KernelKind,
+    variance: f32,
+    jitter: f64,
+    tau: &mut [f64],
+    k: &mut [f32],
+    kd: Option<&mut [f64]>,
+) {
+    match kind {
+        KernelKind::Matern32 => shape_passes(
+            (tau, k, kd),
+            variance,
+            |t| ((3.0 * (t + jitter)) as f32).sqrt(),
+            |p| (-p, 1.0 + p),
+            -1.5,
+        ),
+        KernelKind::SquaredExponential => shape_passes(
+            (tau, k, kd),
+            variance,
+            |t| (-0.5 * t) as f32,
+            |p| (p, 1.0),
+            -0.5,
+        ),
+    }
+}
+
+/// The loops of [`apply_shape_f32`] as separate passes over slices of one type each, so that
+/// the `f32` work runs on 8 lanes and not on the 4 of `τ`'s `f64`: `p` narrowed into `k`,
+/// then `k` and `σ_f² eˣ` (into `τ`'s bytes), then `kd` widened.
+#[inline(always)]
+fn shape_passes(
+    (tau, k, kd): (&mut [f64], &mut [f32], Option<&mut [f64]>),
+    variance: f32,
+    p_of: impl Fn(f64) -> f32,
+    x_c: impl Fn(f32) -> (f32, f32),
+    dc: f64,
+) {
+    let n = k.len();
+    k.iter_mut().zip(&tau[..n]).for_each(|(k, &t)| *k = p_of(t));
+    match kd {
+        Some(kd) => {
+            let e: &mut [f32] = &mut bytemuck::cast_slice_mut(&mut tau[..n])[..n];
+            for (k, e) in k.iter_mut().zip(e.iter_mut()) {
+                let (x, c) = x_c(*k);
+                *e = variance * exp_f32(x);
+                *k = operand(c * *e);
+            }
+            kd[..n]
+                .iter_mut()
+                .zip(&*e)
+                .for_each(|(d, &e)| *d = dc * f64::from(e));
+        }
+        None => k.iter_mut().for_each(|k| {
+            let (x, c) = x_c(*k);
+            *k = operand(c * (variance * exp_f32(x)));
+        }),
+    }
+}
+
+/// A kernel value as an `f32` product operand: zero below [`F32_OPERAND_FLOOR`] (`K ≥ 0`).
+#[inline(always)]
+fn operand(v: f32) -> f32 {
+    if v < F32_OPERAND_FLOOR as f32 { 0.0 } else { v }
 }
 
 /// Reverse mode of [`cross_cov`] with respect to the inducing inputs, the points and the
@@ -451,6 +595,98 @@ mod tests {
         }
     }
 
+    /// The `f32` shape against the `f64` kernel: `K` and `σ_f² g'` within `2·2⁻²³ σ_f²`, `K`
+    /// within 4 `f32` roundings where it is large, zero where it is below the operand floor
+    /// (a far point); the same `K` with and without the derivative.
+    #[test]
+    fn f32_shape_matches_the_f64_kernel() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(6);
+        let (m, d, dx, group, n) = (13, 5, 3, 3, 7);
+        let z: Vec<f64> = (0..m * d).map(|_| rng.random_range(-2.0..2.0)).collect();
+        let inv_len: Vec<f64> = (0..d).map(|_| rng.random_range(0.5..2.0)).collect();
+        let mut pts: Vec<f64> = (0..n * d).map(|_| rng.random_range(-2.0..2.0)).collect();
+        // A far point (first group) and one on the first inducing input (second group).
+        pts[..d].iter_mut().for_each(|p| *p = 40.0);
+        pts[group * d..(group + 1) * d].copy_from_slice(&z[..d]);
+        for c in 0..n {
+            let first = (c / group) * group;
+            for j in dx..d {
+                pts[c * d + j] = pts[first * d + j];
+            }
+        }
+        let mut zt = vec![0.0; d * m];
+        scale_inducing(&z, &inv_len, &mut zt);
+        let mut xs = vec![0.0; d * n];
+        scale_points(&pts, &inv_len, &mut xs);
+        for kind in [KernelKind::Matern32, KernelKind::SquaredExponential] {
+            let (mut k, mut kd, mut shared) = (vec![0.0; m * n], vec![0.0; m * n], vec![0.0; m]);
+            let args = (kind, 0.7, 1e-8, &zt[..], &xs[..], d, (dx, group));
+            cross_cov_grouped(
+                args.0,
+                args.1,
+                args.2,
+                args.3,
+                args.4,
+                args.5,
+                args.6,
+                &mut k,
+                &mut kd,
+                &mut shared,
+            );
+            let (mut tau, mut k32, mut kd32) =
+                (vec![0.0; m * n], vec![0.0f32; m * n], vec![0.0; m * n]);
+            let mut values = vec![0.0f32; m * n];
+            cross_cov_grouped_f32(
+                args.0,
+                args.1,
+                args.2,
+                args.3,
+                args.4,
+                args.5,
+                args.6,
+                &mut tau,
+                &mut k32,
+                Some(&mut kd32),
+                &mut shared,
+            );
+            cross_cov_grouped_f32(
+                args.0,
+                args.1,
+                args.2,
+                args.3,
+                args.4,
+                args.5,
+                args.6,
+                &mut tau,
+                &mut values,
+                None,
+                &mut shared,
+            );
+            assert_eq!(values, k32, "{kind:?}: with and without the derivative");
+            // The argument's rounding moves `e^{−r}` by `r·2⁻²⁴` relative, and `r e^{−r} ≤ 1/e`:
+            // errors are bounded in units of `σ_f²`, and relative ones where `K` is large.
+            let eps = f64::from(f32::EPSILON);
+            let mut floored = 0;
+            for i in 0..m * n {
+                let (dk, dkd) = (f64::from(k32[i]) - k[i], kd32[i] - kd[i]);
+                if k[i] < F32_OPERAND_FLOOR {
+                    assert_eq!(k32[i], 0.0, "{kind:?} {i}");
+                    floored += 1;
+                }
+                assert!(dk.abs() < 2.0 * eps * 0.7, "{kind:?} K {i}: {dk:e}");
+                assert!(dkd.abs() < 2.0 * eps * 0.7, "{kind:?} K' {i}: {dkd:e}");
+                if k[i] > 0.1 {
+                    assert!(dk.abs() / k[i] < 4.0 * eps, "{kind:?} K {i}: {dk:e}");
+                }
+            }
+            assert!(floored > 0, "{kind:?}: the far point reaches the floor");
+            assert!(
+                (k32[group * m] - 0.7).abs() < 1e-6,
+                "{kind:?}: K at an inducing input"
+            );
+        }
+    }
+
     #[test]
     fn exp_within_one_ulp_of_libm() {
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
@@ -478,6 +714,23 @@ mod tests {
         assert_eq!(exp(1e300), exp(709.0));
         assert_eq!(exp(0.0), 1.0);
         assert!(exp(f64::NAN).is_nan());
+    }
+
+    #[test]
+    fn exp_f32_is_within_f32_rounding_over_the_kernels_range() {
+        let mut worst = 0.0f64;
+        for i in 0..86_990 {
+            let x = -(i as f32) * 1e-3;
+            let e = f64::from(exp_f32(x));
+            let rel = (e - f64::from(x).exp()).abs() / f64::from(x).exp();
+            worst = worst.max(rel);
+        }
+        // Measured 7.6e-8.
+        assert!(worst < 2e-7, "relative error {worst:e}");
+        assert_eq!(exp_f32(-200.0), exp_f32(-87.0));
+        assert!(exp_f32(-87.0) > 0.0);
+        assert_eq!(exp_f32(0.0), 1.0);
+        assert!(exp_f32(f32::NAN).is_nan());
     }
 
     #[test]

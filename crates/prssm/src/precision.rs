@@ -11,15 +11,20 @@
 //!
 //! and, for diagonal `S`, the three `D_x`-row products `S(W⊙W)`, `Sᵀσ̄²` and `σ̄²(W⊙W)ᵀ`
 //! (sums of terms of one sign, or one sign per factor, so `f32` loses no more than its rounding).
-//! Their operands are rounded to `f32` (`[G; mᵀG]` and `S` once per evaluation, the others per
-//! step), the products are formed in `f32`, and their results are widened back: most feed `f64`
-//! code, the parameter adjoints are added to their `f64` sums over steps. Everything else stays
-//! `f64`: the kernel, the factorization of `K_mm`, `G`, the cancellation `σ_f² − Σ H⊙W` of the
-//! predictive variance (from the widened `W`), the KL, the likelihood, the draws and every
-//! reduction. The variance's cancellation sees `W`'s `f32` rounding, so a variance can come
-//! out below zero by about `2⁻²⁴ Σ|H||W|`; the transition adds `σ_x² + δ` to it, and a step
-//! whose total is not positive gives a non-finite loss, which the trainer's divergence guard
-//! rejects like any other.
+//! The kernel `K = σ_f² g(τ)` these products read is formed in `f32` too: `τ` is summed in
+//! `f64`, then the shape (`√`, `exp`, `(1 + r)e⁻ʳ`) runs on `f32` lanes
+//! (`kernel::cross_cov_grouped_f32`, twice the lanes of `f64`), which moves `K` by at most
+//! `2·2⁻²³ σ_f²` (`kernel::tests::f32_shape_matches_the_f64_kernel`); `σ_f² g'` for the reverse
+//! pass is widened to `f64`. The other operands are rounded to `f32` (`[G; mᵀG]` and `S` once
+//! per evaluation, the others per step), the products are formed in `f32`, and their results
+//! are widened back: most feed `f64` code, the parameter adjoints are added to their `f64` sums
+//! over steps. Everything else stays `f64`: `τ`, the factorization of `K_mm`, `G`, the
+//! cancellation `σ_f² − Σ H⊙W` of the predictive variance (summed in `f64` from the `f32` `K`
+//! and the widened `W`), the KL, the likelihood, the draws, the kernel's reverse mode (whose
+//! expanded sums `Σ z̃c − x̃s` cancel) and every reduction. The variance's cancellation sees
+//! the `f32` rounding of `K` and `W`, so a variance can come out below zero by about
+//! `2⁻²⁴ Σ|H||W|`; the transition adds `σ_x² + δ` to it, and a step whose total is not positive
+//! gives a non-finite loss, which the trainer's divergence guard rejects like any other.
 //!
 //! Every `f32` operand is rounded by `linalg::f32_operand`: a magnitude below `2⁻⁶²` becomes
 //! zero, so that no product of two operands is subnormal. Subnormal `f32` values (below
@@ -29,8 +34,8 @@
 //!
 //! Prediction and streaming take the same choice (`StepPredictor::with_precision`,
 //! `predict::predict_with_precision`, `StreamPredictor::with_precision`): the forward product
-//! `[W; μ] = [G; mᵀG] K` and `S(W⊙W)` in `f32`, the kernel and the variance's cancellation in
-//! `f64`; a variance that `W`'s rounding takes below zero counts as zero there.
+//! `[W; μ] = [G; mᵀG] K`, `S(W⊙W)` and the kernel's shape in `f32`, `τ` and the variance's
+//! cancellation in `f64`; a variance that the rounding takes below zero counts as zero there.
 //!
 //! [`Precision::F64`] is the reference; `tests/mixed_precision.rs` measures the difference.
 
@@ -43,7 +48,8 @@ pub enum Precision {
     /// Everything in `f64` (the reference).
     #[default]
     F64,
-    /// The three large products of each step in `f32`, the rest in `f64`.
+    /// The three large products of each step and the kernel's shape in `f32`, the rest in
+    /// `f64`.
     Mixed,
 }
 

@@ -19,7 +19,7 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
 
-use crate::kernel::KernelKind;
+use crate::kernel::{KernelKind, exp_f32 as exp};
 use crate::model::PrssmModel;
 use crate::objective::ObjectiveError;
 use crate::params::CovarianceStructure;
@@ -333,45 +333,9 @@ fn dot(a: &[f32], b: &[f32]) -> f32 {
     acc.iter().sum::<f32>() + tail
 }
 
-/// `eˣ` in `f32`, branch-free (vectorizable) for `x ≤ 0` as the kernels need: `x = k ln2 + r`,
-/// `|r| ≤ ln2/2` (Cody–Waite), `eʳ` by its degree-7 Taylor polynomial (truncation `< 2·10⁻⁸`; with `f32`
-/// rounding within `10⁻⁷` of `eˣ`, tested), scaled by `2ᵏ` through the exponent bits; `x < −87` is taken
-/// as `−87` (`e⁻⁸⁷ ≈ 1.6·10⁻³⁸`).
-#[inline(always)]
-fn exp(x: f32) -> f32 {
-    let x = x.max(-87.0);
-    let k = (x * std::f32::consts::LOG2_E).round();
-    // ln2 = LN2_HI + LN2_LO (Cody–Waite): `k · LN2_HI` is exact for |k| < 2¹⁵.
-    const LN2_HI: f32 = 0.693_359_4;
-    const LN2_LO: f32 = -2.121_944_4e-4;
-    let r = (x - k * LN2_HI) - k * LN2_LO;
-    let p = 1.0
-        + r * (1.0
-            + r * (0.5
-                + r * (1.0 / 6.0
-                    + r * (1.0 / 24.0 + r * (1.0 / 120.0 + r * (1.0 / 720.0 + r / 5040.0))))));
-    let scale = f32::from_bits((((k as i32) + 127) as u32) << 23);
-    p * scale
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn exp_is_within_f32_rounding_over_the_kernels_range() {
-        let mut worst = 0.0f64;
-        for i in 0..86_990 {
-            let x = -(i as f32) * 1e-3;
-            let e = f64::from(exp(x));
-            let rel = (e - f64::from(x).exp()).abs() / f64::from(x).exp();
-            worst = worst.max(rel);
-        }
-        // Measured 9.5e-8.
-        assert!(worst < 2e-7, "relative error {worst:e}");
-        assert_eq!(exp(-200.0), exp(-87.0));
-        assert!(exp(-87.0) > 0.0);
-    }
 
     #[test]
     fn dot_equals_the_plain_sum() {

@@ -41,8 +41,8 @@ use faer::{Accum, MatRef};
 
 use crate::kernel::{self, KernelKind};
 use crate::linalg::{
-    cholesky_backward, cholesky_in_place, f32_operand, gemm, lower_inverse, round_into, view,
-    view_mut, widen_into,
+    cholesky_backward, cholesky_in_place, f32_operand, gemm, lower_inverse, view, view_mut,
+    widen_into,
 };
 use crate::objective::ObjectiveError;
 use crate::params::{CovarianceStructure, ModelConfig, Parametrization, Params};
@@ -228,37 +228,37 @@ impl Posterior {
     }
 }
 
-/// The forward product `[W; μ] = [G; mᵀG] K` of `n` points into `wm` (`(M + D_x) × N`): in
-/// `f64`, or, given the `f32` buffers `(K, [W; μ])` of a mixed posterior, on `K` rounded to
-/// `f32` and widened back ([`crate::precision`]).
-pub(crate) fn forward_product(
+/// The forward product `[W; μ] = [G; mᵀG] K` of `n` points into `wm` (`(M + D_x) × N`), in
+/// `f64`.
+pub(crate) fn forward_product(post: &Posterior, k: &[f64], n: usize, wm: &mut [f64]) {
+    let (m, r) = (post.m, post.m + post.dx);
+    gemm(
+        view_mut(wm, r, n),
+        Accum::Replace,
+        post.g_mean(),
+        view(k, m, n),
+        1.0,
+    );
+}
+
+/// [`forward_product`] in `f32` for a mixed posterior ([`crate::precision`]), from the `f32`
+/// kernel `k32` (`M × N`): `[W; μ]` formed in `wm32` and widened into `wm`. Allocates nothing.
+pub(crate) fn forward_product_f32(
     post: &Posterior,
-    k: &[f64],
+    k32: &[f32],
     n: usize,
     wm: &mut [f64],
-    mixed: Option<(&mut [f32], &mut [f32])>,
+    wm32: &mut [f32],
 ) {
     let (m, r) = (post.m, post.m + post.dx);
-    match mixed {
-        None => gemm(
-            view_mut(wm, r, n),
-            Accum::Replace,
-            post.g_mean(),
-            view(k, m, n),
-            1.0,
-        ),
-        Some((k32, wm32)) => {
-            round_into(&k[..m * n], k32);
-            gemm(
-                view_mut(wm32, r, n),
-                Accum::Replace,
-                post.g_mean32(),
-                view(k32, m, n),
-                1.0,
-            );
-            widen_into(&wm32[..r * n], wm, Accum::Replace);
-        }
-    }
+    gemm(
+        view_mut(wm32, r, n),
+        Accum::Replace,
+        post.g_mean32(),
+        view(k32, m, n),
+        1.0,
+    );
+    widen_into(&wm32[..r * n], wm, Accum::Replace);
 }
 
 #[cfg(test)]

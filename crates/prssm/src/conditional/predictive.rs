@@ -2,7 +2,7 @@
 
 use faer::Accum;
 
-use super::{Posterior, forward_product};
+use super::{Posterior, forward_product, forward_product_f32};
 use crate::kernel;
 use crate::linalg::{dot, f32_operand, gemm, view, view_mut, widen_into};
 use crate::params::CovarianceStructure;
@@ -10,8 +10,9 @@ use crate::precision::Precision;
 
 /// Forward-only conditional for prediction (no derivatives, no tape). `W` and the means come
 /// from one product `[W; μ] = [G; mᵀG] K` (`(M + D_x) × N`); `σ²` as in [`ConditionalWorkspace`].
-/// Under a [`Precision::Mixed`] posterior the product and `S(W⊙W)` run in `f32`, as in training
-/// ([`crate::precision`]); the kernel and the cancellation `σ_f² − Σ H⊙W` stay `f64`.
+/// Under a [`Precision::Mixed`] posterior the kernel's shape (`τ` stays `f64`), the product and
+/// `S(W⊙W)` run in `f32` ([`crate::precision`]); the cancellation `σ_f² − Σ H⊙W` is summed in
+/// `f64` from the `f32` `K` and the widened `W`.
 #[derive(Debug, Clone)]
 pub(crate) struct PredictiveWorkspace {
     cap: usize,
@@ -26,9 +27,9 @@ pub(crate) struct PredictiveWorkspace {
     tau_shared: Vec<f64>,
     /// Variances `σ²`, column-major `D_x × N`.
     pub var: Vec<f64>,
-    /// `f32` operands and results under [`Precision::Mixed`]: `K`, then `W⊙W` (`M × N`),
-    /// `[W; μ]` (`(M + D_x) × N`), `S(W⊙W)` (`D_x × N`).
-    mixed: Option<[Vec<f32>; 3]>,
+    /// `f32` operands and results under [`Precision::Mixed`]: `K` (`M × N`), `[W; μ]`
+    /// (`(M + D_x) × N`), `S(W⊙W)` (`D_x × N`), `W⊙W` (`M × N`).
+    mixed: Option<[Vec<f32>; 4]>,
 }
 
 impl PredictiveWorkspace {
@@ -46,8 +47,14 @@ impl PredictiveWorkspace {
             w2: vec![0.0; m * n],
             tau_shared: vec![0.0; m],
             var: vec![0.0; dx * n],
-            mixed: (post.precision() == Precision::Mixed)
-                .then(|| [vec![0.0; m * n], vec![0.0; (m + dx) * n], vec![0.0; dx * n]]),
+            mixed: (post.precision() == Precision::Mixed).then(|| {
+                [
+                    vec![0.0; m * n],
+                    vec![0.0; (m + dx) * n],
+                    vec![0.0; dx * n],
+                    vec![0.0; m * n],
+                ]
+            }),
         }
     }
 
@@ -64,33 +71,51 @@ impl PredictiveWorkspace {
         debug_assert!(n <= self.cap);
         let r = m + dx;
         kernel::scale_points(&self.input[..d * n], &post.inv_len, &mut self.xs[..d * n]);
-        kernel::cross_cov_grouped_values(
-            post.kind,
-            post.variance,
-            post.tau_jitter,
-            &post.zt,
-            &self.xs[..d * n],
-            d,
-            (dx, self.group),
-            &mut self.k[..m * n],
-            &mut self.tau_shared,
-        );
-        let products = self
-            .mixed
-            .as_mut()
-            .map(|[k, wm, _]| (&mut k[..], &mut wm[..]));
-        forward_product(post, &self.k, n, &mut self.wm, products);
-        let mixed = self
-            .mixed
-            .as_mut()
-            .map(|[w2, _, var]| (&mut w2[..], &mut var[..]));
-        let k = if post.whitened {
-            None
-        } else {
-            Some(&self.k[..])
-        };
+        let args = (post.kind, post.variance, post.tau_jitter, &post.zt[..]);
+        let xs = &self.xs[..d * n];
+        let group = (dx, self.group);
         let (w2, var) = (&mut self.w2, &mut self.var);
-        write_predictive_variance(post, &self.wm, r, k, n, w2, var, None, mixed);
+        match self.mixed.as_mut() {
+            None => {
+                let k = &mut self.k[..m * n];
+                let (kind, variance, jitter, zt) = args;
+                kernel::cross_cov_grouped_values(
+                    kind,
+                    variance,
+                    jitter,
+                    zt,
+                    xs,
+                    d,
+                    group,
+                    k,
+                    &mut self.tau_shared,
+                );
+                forward_product(post, k, n, &mut self.wm);
+                let h = (!post.whitened).then_some(&*k);
+                write_predictive_variance(post, &self.wm, r, h, n, w2, var, None, None);
+            }
+            Some([k32, wm32, var32, w2_32]) => {
+                // `self.k` holds `τ`; `K` exists only in `f32`.
+                let (kind, variance, jitter, zt) = args;
+                kernel::cross_cov_grouped_f32(
+                    kind,
+                    variance,
+                    jitter,
+                    zt,
+                    xs,
+                    d,
+                    group,
+                    &mut self.k,
+                    k32,
+                    None,
+                    &mut self.tau_shared,
+                );
+                forward_product_f32(post, k32, n, &mut self.wm, wm32);
+                let h = (!post.whitened).then_some(&k32[..m * n]);
+                let mixed = Some((&mut w2_32[..], &mut var32[..]));
+                write_predictive_variance(post, &self.wm, r, h, n, w2, var, None, mixed);
+            }
+        }
     }
 }
 
@@ -103,11 +128,11 @@ impl PredictiveWorkspace {
 /// posterior of diagonal `S`, the sum `S(W⊙W)` of positive terms is formed in `f32`.
 /// Allocates nothing.
 #[allow(clippy::too_many_arguments)]
-pub(super) fn write_predictive_variance(
+pub(super) fn write_predictive_variance<H: Copy + Into<f64>>(
     post: &Posterior,
     w: &[f64],
     stride: usize,
-    k: Option<&[f64]>,
+    k: Option<&[H]>,
     n: usize,
     w2: &mut [f64],
     var: &mut [f64],
@@ -163,8 +188,10 @@ pub(super) fn write_predictive_variance(
     }
     for (j, v) in var[..dx * n].chunks_exact_mut(dx).enumerate() {
         let wc = &w[j * stride..j * stride + m];
-        let hc = k.map_or(wc, |k| &k[j * m..(j + 1) * m]);
-        let wh = dot(wc, hc);
+        let wh = match k {
+            Some(k) => dot(wc, &k[j * m..(j + 1) * m]),
+            None => dot(wc, wc),
+        };
         if let Some(q) = quad.as_deref_mut() {
             q[j * dx..(j + 1) * dx]
                 .iter_mut()

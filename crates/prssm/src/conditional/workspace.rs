@@ -4,7 +4,7 @@
 use faer::Accum;
 
 use super::predictive::write_predictive_variance;
-use super::{Posterior, forward_product};
+use super::{Posterior, forward_product, forward_product_f32};
 use crate::kernel;
 use crate::linalg::{dot, f32_operand, gemm, round_into, view, view_mut, widen_into};
 use crate::params::CovarianceStructure;
@@ -207,38 +207,55 @@ impl ConditionalWorkspace {
         let t = split_tape(post, self.cap, n, tape);
         let k = &mut self.k[..m * n];
         kernel::scale_points(&self.input[..d * n], &post.inv_len, t.xs);
-        kernel::cross_cov_grouped(
-            post.kind,
-            post.variance,
-            post.tau_jitter,
-            &post.zt,
-            t.xs,
-            d,
-            (dx, self.input_group.max(1)),
-            k,
-            t.kd,
-            &mut self.rowsum,
-        );
+        let (kind, variance, jitter, zt) = (post.kind, post.variance, post.tau_jitter, &post.zt);
+        let group = (dx, self.input_group.max(1));
         let r = m + dx;
-        let mixed = self
-            .mixed
-            .as_mut()
-            .map(|mx| (&mut mx.k[..], &mut mx.wm[..]));
-        forward_product(post, k, n, t.wm, mixed);
-        let wm = &*t.wm;
+        let (w2, var) = (&mut self.w2, &mut self.var);
+        match self.mixed.as_mut() {
+            None => {
+                kernel::cross_cov_grouped(
+                    kind,
+                    variance,
+                    jitter,
+                    zt,
+                    t.xs,
+                    d,
+                    group,
+                    k,
+                    t.kd,
+                    &mut self.rowsum,
+                );
+                forward_product(post, k, n, t.wm);
+                let h = (!post.whitened).then_some(&*k);
+                write_predictive_variance(post, t.wm, r, h, n, w2, var, Some(t.quad), None);
+            }
+            Some(mx) => {
+                // `k` holds `τ`; `K` exists only in `f32`. `mx.y` is scratch until the reverse.
+                kernel::cross_cov_grouped_f32(
+                    kind,
+                    variance,
+                    jitter,
+                    zt,
+                    t.xs,
+                    d,
+                    group,
+                    k,
+                    &mut mx.k,
+                    Some(t.kd),
+                    &mut self.rowsum,
+                );
+                forward_product_f32(post, &mx.k, n, t.wm, &mut mx.wm);
+                let h = (!post.whitened).then_some(&mx.k[..m * n]);
+                let mixed = Some((&mut mx.y[..], &mut mx.var[..]));
+                write_predictive_variance(post, t.wm, r, h, n, w2, var, Some(t.quad), mixed);
+            }
+        }
         for (mean, col) in self.mean[..dx * n]
             .chunks_exact_mut(dx)
-            .zip(wm.chunks_exact(r))
+            .zip(t.wm.chunks_exact(r))
         {
             mean.copy_from_slice(&col[m..]);
         }
-        let h = if post.whitened { None } else { Some(&*k) };
-        let mixed = self
-            .mixed
-            .as_mut()
-            .map(|mx| (&mut mx.k[..], &mut mx.var[..]));
-        let (w2, var) = (&mut self.w2, &mut self.var);
-        write_predictive_variance(post, wm, r, h, n, w2, var, Some(t.quad), mixed);
     }
 
     /// Reverse mode of the last [`Self::forward`] on `n` points: given `mean_bar`, `var_bar`
