@@ -4,8 +4,9 @@
 
 use flapssm_prssm::Precision;
 use flapssm_prssm::train::bench::{
-    REFERENCE_SOLVE_S, gemm_rate_gflops, initial_model, predict_step_flops,
+    REFERENCE_SOLVE_S, gemm_rate_gflops, initial_model, predict_step_f32_flops, predict_step_flops,
     reference_solve_seconds, synthetic_objective, time_batches, time_prediction, time_stream_step,
+    train_step_f32_flops, train_step_flops,
 };
 use flapssm_prssm::train::fit::{DEFAULT_WINDOWS_PER_TASK, FitError, FitSpec, Preset};
 
@@ -61,6 +62,12 @@ pub struct BenchReport {
     pub threads: usize,
     /// f64 GEMM rate (512³, faer, one thread), GFLOP/s.
     pub gemm_gflops: f64,
+    /// f32 GEMM rate (512³, faer, one thread), GFLOP/s.
+    pub gemm_f32_gflops: f64,
+    /// Share of the training FLOP that the timed precision runs in `f32` (0 for `f64`).
+    pub train_f32_share: f64,
+    /// Share of the prediction FLOP that the timed precision runs in `f32` (0 for `f64`).
+    pub predict_f32_share: f64,
     /// prssm-notes §4's triangular solve (100 × 100, 480 right-hand sides, one thread), s.
     pub reference_solve_s: f64,
     /// Minibatches timed.
@@ -85,6 +92,23 @@ impl BenchReport {
     /// Epoch time if every FLOP ran at `threads` × the f64 GEMM rate (the f64 FLOP limit), s.
     pub fn flop_limit_epoch_s(&self) -> f64 {
         self.epoch_s * self.train_gflops / (self.threads as f64 * self.gemm_gflops)
+    }
+
+    /// Epoch time if every FLOP ran at `threads` × the GEMM rate of its precision (the FLOP
+    /// limit of the timed precision: the f64 one for `f64`), s.
+    pub fn precision_flop_limit_epoch_s(&self) -> f64 {
+        let gflop = self.epoch_s * self.train_gflops;
+        let per_core = self.train_f32_share / self.gemm_f32_gflops
+            + (1.0 - self.train_f32_share) / self.gemm_gflops;
+        gflop * per_core / self.threads as f64
+    }
+
+    /// Prediction time if every FLOP ran at the one-thread GEMM rate of its precision, s.
+    pub fn precision_flop_limit_predict_s(&self) -> f64 {
+        let gflop = self.predict_s * self.predict_gflops;
+        gflop
+            * (self.predict_f32_share / self.gemm_f32_gflops
+                + (1.0 - self.predict_f32_share) / self.gemm_gflops)
     }
 }
 
@@ -123,7 +147,8 @@ pub fn bench(settings: &BenchSettings) -> Result<BenchReport> {
         windows_per_task: settings.windows_per_task,
         ..FitSpec::preset(Preset::Paper, 7, 5)
     };
-    let gemm_gflops = gemm_rate_gflops(512, 0.3);
+    let gemm_gflops = gemm_rate_gflops::<f64>(512, 0.3);
+    let gemm_f32_gflops = gemm_rate_gflops::<f32>(512, 0.3);
     let reference_solve_s = reference_solve_seconds(0.2);
     let (elbo, params) = synthetic_objective(&spec, TRAIN_SEQUENCES, PREDICT_STEPS, settings.seed)
         .map_err(|e| engine("building the paper objective", e.into()))?;
@@ -143,11 +168,24 @@ pub fn bench(settings: &BenchSettings) -> Result<BenchReport> {
     let step_flops = predict_step_flops(&model.config, spec.particles);
     let stream_step_s = time_stream_step(&model, spec.particles, 2000, settings.precision)
         .map_err(|e| engine("timing streaming", e.into()))?;
+    let mixed = settings.precision == Precision::Mixed;
+    let share = |part: f64, all: f64| if mixed { part / all } else { 0.0 };
+    let train_f32_share = share(
+        train_step_f32_flops(&spec.model, spec.particles),
+        train_step_flops(&spec.model, spec.particles),
+    );
+    let predict_f32_share = share(
+        predict_step_f32_flops(&model.config, spec.particles),
+        step_flops,
+    );
     Ok(BenchReport {
         precision: settings.precision,
         windows_per_task: settings.windows_per_task,
         threads: current_threads(),
         gemm_gflops,
+        gemm_f32_gflops,
+        train_f32_share,
+        predict_f32_share,
         reference_solve_s,
         batches: settings.batches,
         epoch_s: times.total_s * per_epoch,
@@ -164,4 +202,44 @@ pub fn bench(settings: &BenchSettings) -> Result<BenchReport> {
 /// relative to it.
 pub fn speed_against_reference_machine(report: &BenchReport) -> f64 {
     REFERENCE_SOLVE_S / report.reference_solve_s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn report(precision: Precision, train_f32_share: f64, predict_f32_share: f64) -> BenchReport {
+        BenchReport {
+            precision,
+            windows_per_task: 4,
+            threads: 2,
+            gemm_gflops: 40.0,
+            gemm_f32_gflops: 80.0,
+            train_f32_share,
+            predict_f32_share,
+            reference_solve_s: 1e-4,
+            batches: 8,
+            epoch_s: 10.0,
+            fastest_epoch_s: 9.0,
+            train_gflops: 40.0,
+            predict_s: 0.01,
+            predict_gflops: 20.0,
+            stream_step_s: 2e-5,
+            stream_gflops: 20.0,
+        }
+    }
+
+    /// 400 GFLOP per epoch on 2 cores at 40 GFLOP/s each: 5 s; with half of them at the
+    /// doubled f32 rate, 3.75 s. 0.2 GFLOP per prediction: 5 ms, and 3.75 ms.
+    #[test]
+    fn flop_limits_weigh_each_precision_by_its_rate() {
+        let f64_run = report(Precision::F64, 0.0, 0.0);
+        assert!((f64_run.flop_limit_epoch_s() - 5.0).abs() < 1e-12);
+        assert!((f64_run.precision_flop_limit_epoch_s() - 5.0).abs() < 1e-12);
+        assert!((f64_run.precision_flop_limit_predict_s() - 5e-3).abs() < 1e-15);
+        let mixed = report(Precision::Mixed, 0.5, 0.5);
+        assert!((mixed.flop_limit_epoch_s() - 5.0).abs() < 1e-12);
+        assert!((mixed.precision_flop_limit_epoch_s() - 3.75).abs() < 1e-12);
+        assert!((mixed.precision_flop_limit_predict_s() - 3.75e-3).abs() < 1e-15);
+    }
 }

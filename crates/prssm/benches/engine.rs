@@ -69,7 +69,7 @@ fn cpu_seconds() -> Option<f64> {
 
 fn bench(c: &mut Criterion) {
     let (elbo, theta, config, params, u) = setup();
-    let gemm = gemm_rate_gflops(512, 0.3);
+    let gemm = gemm_rate_gflops::<f64>(512, 0.3);
     println!("f64 GEMM 512 x 512 x 512 (faer, one thread): {gemm:.1} GFLOP/s per core");
     if std::env::var_os("PREDICT_ONLY").is_none() {
         bench_elbo(c, &elbo, &theta, gemm);

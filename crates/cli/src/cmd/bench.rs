@@ -144,8 +144,8 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
     .context("flapssm bench")?;
     let threads = r.threads;
     println!(
-        "this machine: f64 GEMM (512 x 512 x 512, faer, 1 thread) {:.1} GFLOP/s per core",
-        r.gemm_gflops
+        "this machine: f64 GEMM (512 x 512 x 512, faer, 1 thread) {:.1} GFLOP/s per core; f32 GEMM {:.1}",
+        r.gemm_gflops, r.gemm_f32_gflops
     );
     println!(
         "  faer triangular solve (100 x 100, 480 right-hand sides, 1 thread): {:.1} us; \
@@ -169,6 +169,13 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
         100.0 * r.train_gflops / (threads as f64 * r.gemm_gflops),
         r.flop_limit_epoch_s()
     );
+    if r.precision == Precision::Mixed {
+        println!(
+            "  the mixed FLOP limit ({:.0} % of the FLOP, the f32 products, at {threads} x the f32 GEMM rate, the rest at the f64 rate): {:.2} s per epoch",
+            100.0 * r.train_f32_share,
+            r.precision_flop_limit_epoch_s()
+        );
+    }
     println!(
         "  fastest minibatch x 32: {:.3} s (the epoch above includes any outside load on this machine)",
         r.fastest_epoch_s
@@ -181,6 +188,11 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
         r.predict_gflops,
         100.0 * r.predict_gflops / r.gemm_gflops,
         AUTHORS_PREDICT_S / r.predict_s
+    );
+    println!(
+        "  all FLOP at the GEMM rate of their precision ({:.0} % in f32): {:.2} ms",
+        100.0 * r.predict_f32_share,
+        r.precision_flop_limit_predict_s() * 1e3
     );
     println!(
         "streaming step (30 particles, {} precision): {:.1} us, {:.1} GFLOP/s",

@@ -6,6 +6,7 @@ use std::time::Instant;
 
 use faer::linalg::matmul::matmul;
 use faer::linalg::triangular_solve::solve_lower_triangular_in_place;
+use faer::traits::ComplexField;
 use faer::{Accum, Mat, Par};
 
 use super::batches::{BatchPlan, WindowSpec, derive_seed};
@@ -45,15 +46,35 @@ pub fn predict_step_flops(config: &ModelConfig, particles: usize) -> f64 {
     2.0 * (m + dx) * m * p + 2.0 * dx * m * p + 2.0 * m * dx * p
 }
 
-/// This machine's f64 matrix-product rate on one thread (GFLOP/s): the best of repeated
-/// `size × size × size` faer products over at least `min_seconds`. Near the core's FLOP
-/// limit, it bounds what the engine (≈ 70 % of its FLOP in such products) can reach.
-pub fn gemm_rate_gflops(size: usize, min_seconds: f64) -> f64 {
+/// The part of [`train_step_flops`] that [`Precision::Mixed`] runs in `f32`: the three large
+/// products with their `D_x` mean rows and the three `D_x`-row variance products
+/// (`6 M² N + 12 M D_x N`); the kernel's distances and their adjoint products stay `f64`.
+pub fn train_step_f32_flops(config: &ModelConfig, n_points: usize) -> f64 {
+    let (m, dx) = (config.n_inducing as f64, config.n_state as f64);
+    let n = n_points as f64;
+    6.0 * m * m * n + 12.0 * m * dx * n
+}
+
+/// The part of [`predict_step_flops`] that [`Precision::Mixed`] runs in `f32`: the product
+/// `[W; μ] = [G; mᵀG] K` and `S (W ⊙ W)` (`2 (M + D_x) M P + 2 D_x M P`).
+pub fn predict_step_f32_flops(config: &ModelConfig, particles: usize) -> f64 {
+    let (m, dx) = (config.n_inducing as f64, config.n_state as f64);
+    let p = particles as f64;
+    2.0 * (m + dx) * m * p + 2.0 * dx * m * p
+}
+
+/// This machine's matrix-product rate on one thread (GFLOP/s) in `T` (`f64` or `f32`): the
+/// best of repeated `size × size × size` faer products over at least `min_seconds`. Near the
+/// core's FLOP limit, it bounds what the engine (≈ 70 % of its FLOP in such products) can
+/// reach.
+pub fn gemm_rate_gflops<T: ComplexField + From<f32>>(size: usize, min_seconds: f64) -> f64 {
     let size = size.max(8);
-    let a = Mat::<f64>::from_fn(size, size, |i, j| ((i * 31 + j * 17) % 97) as f64 / 97.0);
-    let b = Mat::<f64>::from_fn(size, size, |i, j| ((i * 13 + j * 29) % 89) as f64 / 89.0);
-    let mut c = Mat::<f64>::zeros(size, size);
+    let entry = |v: usize, q: usize| T::from(v as f32 / q as f32);
+    let a = Mat::<T>::from_fn(size, size, |i, j| entry((i * 31 + j * 17) % 97, 97));
+    let b = Mat::<T>::from_fn(size, size, |i, j| entry((i * 13 + j * 29) % 89, 89));
+    let mut c = Mat::<T>::zeros(size, size);
     let flop = 2.0 * (size as f64).powi(3);
+    let one = T::from(1.0);
     let best = fastest_seconds(
         min_seconds,
         &mut c,
@@ -64,7 +85,7 @@ pub fn gemm_rate_gflops(size: usize, min_seconds: f64) -> f64 {
                 Accum::Replace,
                 a.as_ref(),
                 b.as_ref(),
-                1.0,
+                one.clone(),
                 Par::Seq,
             )
         },
@@ -315,11 +336,20 @@ mod tests {
         assert_eq!(predict, 672_000.0 + 72_000.0 + 72_000.0);
         // Both are linear in the number of points.
         assert_eq!(train_step_flops(&spec.model, 30) * 16.0, train);
+        // Mixed precision's f32 part: the M² and D_x terms, and the two predictive products.
+        let f32_part = train_step_f32_flops(&spec.model, 480);
+        assert_eq!(f32_part, 28_800_000.0 + 6_912_000.0);
+        assert_eq!(
+            predict_step_f32_flops(&spec.model, 30),
+            672_000.0 + 72_000.0
+        );
     }
 
     #[test]
     fn gemm_rate_is_a_finite_positive_rate() {
-        let r = gemm_rate_gflops(16, 0.0);
+        let r = gemm_rate_gflops::<f64>(16, 0.0);
+        assert!(r.is_finite() && r > 0.0, "{r}");
+        let r = gemm_rate_gflops::<f32>(16, 0.0);
         assert!(r.is_finite() && r > 0.0, "{r}");
     }
 
