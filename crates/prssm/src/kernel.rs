@@ -173,54 +173,65 @@ pub fn cross_cov(
     }
 }
 
-/// [`cross_cov`] for points in consecutive groups of `group` that share their coordinates
-/// `shared_from..D` (particles of one window share the input `u`): the shared part of `τ`
-/// is computed once per group into `tau_shared` (`M`). Same results as [`cross_cov`] up to
-/// the order of the sum.
-#[allow(clippy::too_many_arguments)]
+/// The operands of a grouped cross-covariance: the kernel (`kind`, `σ_f²`, the Matern `τ`
+/// jitter), the scaled inducing inputs `zt` (`D·M`, from [`scale_inducing`]) and the scaled
+/// points `xs` (`D × N`, column-major, from [`scale_points`]), whose consecutive groups of
+/// `group` share their coordinates `shared_from..D` (particles of one window share the input
+/// `u`).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct GroupedPoints<'a> {
+    pub kind: KernelKind,
+    pub variance: f64,
+    pub tau_jitter: f64,
+    pub zt: &'a [f64],
+    pub xs: &'a [f64],
+    pub d: usize,
+    pub shared_from: usize,
+    pub group: usize,
+}
+
+impl GroupedPoints<'_> {
+    /// `M`, the number of inducing inputs.
+    fn m(&self) -> usize {
+        self.zt.len() / self.d
+    }
+
+    /// `τ` of group `xg` into `tg` (`M × group`); see [`group_sq_dist`].
+    #[inline(always)]
+    fn group_tau(&self, xg: &[f64], tau_shared: &mut [f64], tg: &mut [f64]) {
+        let (zt, d, from) = (self.zt, self.d, self.shared_from);
+        group_sq_dist(zt, self.m(), d, from, xg, tau_shared, tg);
+    }
+}
+
+/// [`cross_cov`] of grouped points: the shared part of `τ` is computed once per group into
+/// `tau_shared` (`M`). Same results as [`cross_cov`] up to the order of the sum.
 pub(crate) fn cross_cov_grouped(
-    kind: KernelKind,
-    variance: f64,
-    matern_tau_jitter: f64,
-    zt: &[f64],
-    xs: &[f64],
-    d: usize,
-    (shared_from, group): (usize, usize),
+    p: GroupedPoints,
     k: &mut [f64],
     kd: &mut [f64],
     tau_shared: &mut [f64],
 ) {
-    let m_n = zt.len() / d;
+    let (m_n, group) = (p.m(), p.group);
     let tau_shared = &mut tau_shared[..m_n];
     for ((kg, kdg), xg) in k
         .chunks_mut(m_n * group)
         .zip(kd.chunks_mut(m_n * group))
-        .zip(xs.chunks(d * group))
+        .zip(p.xs.chunks(p.d * group))
     {
-        group_sq_dist(zt, m_n, d, shared_from, xg, tau_shared, kg);
-        apply_shape(kind, variance, matern_tau_jitter, kg, kdg);
+        p.group_tau(xg, tau_shared, kg);
+        apply_shape(p.kind, p.variance, p.tau_jitter, kg, kdg);
     }
 }
 
 /// Forward-only [`cross_cov_grouped`]: `K` without the derivative (prediction).
-#[allow(clippy::too_many_arguments)]
-pub(crate) fn cross_cov_grouped_values(
-    kind: KernelKind,
-    variance: f64,
-    matern_tau_jitter: f64,
-    zt: &[f64],
-    xs: &[f64],
-    d: usize,
-    (shared_from, group): (usize, usize),
-    k: &mut [f64],
-    tau_shared: &mut [f64],
-) {
-    let m_n = zt.len() / d;
+pub(crate) fn cross_cov_grouped_values(p: GroupedPoints, k: &mut [f64], tau_shared: &mut [f64]) {
+    let (m_n, group) = (p.m(), p.group);
     let tau_shared = &mut tau_shared[..m_n];
-    for (kg, xg) in k.chunks_mut(m_n * group).zip(xs.chunks(d * group)) {
-        group_sq_dist(zt, m_n, d, shared_from, xg, tau_shared, kg);
+    for (kg, xg) in k.chunks_mut(m_n * group).zip(p.xs.chunks(p.d * group)) {
+        p.group_tau(xg, tau_shared, kg);
         // Over the whole group: one vector loop without per-column scalar tails.
-        apply_shape_values(kind, variance, matern_tau_jitter, kg);
+        apply_shape_values(p.kind, p.variance, p.tau_jitter, kg);
     }
 }
 
@@ -229,37 +240,24 @@ pub(crate) fn cross_cov_grouped_values(
 /// [`exp_f32`] and the `f32` square root, as product operands (values below
 /// [`F32_OPERAND_FLOOR`] become zero), and, if `kd` is given, `σ_f² g'(τ)` widened into it.
 /// Within a few `f32` roundings of the `f64` values; twice the lanes of the `f64` shape.
-#[allow(clippy::too_many_arguments)]
 pub(crate) fn cross_cov_grouped_f32(
-    kind: KernelKind,
-    variance: f64,
-    matern_tau_jitter: f64,
-    zt: &[f64],
-    xs: &[f64],
-    d: usize,
-    (shared_from, group): (usize, usize),
+    p: GroupedPoints,
     tau: &mut [f64],
     k32: &mut [f32],
     mut kd: Option<&mut [f64]>,
     tau_shared: &mut [f64],
 ) {
-    let m_n = zt.len() / d;
+    let (m_n, group) = (p.m(), p.group);
     let tau_shared = &mut tau_shared[..m_n];
-    let n = xs.len() / d;
+    let n = p.xs.len() / p.d;
     let (tau, k32) = (&mut tau[..m_n * n], &mut k32[..m_n * n]);
-    for (g, xg) in xs.chunks(d * group).enumerate() {
+    for (g, xg) in p.xs.chunks(p.d * group).enumerate() {
         let cols = g * m_n * group..((g + 1) * m_n * group).min(m_n * n);
         let tg = &mut tau[cols.clone()];
-        group_sq_dist(zt, m_n, d, shared_from, xg, tau_shared, tg);
+        p.group_tau(xg, tau_shared, tg);
         let kdg = kd.as_deref_mut().map(|kd| &mut kd[cols.clone()]);
-        apply_shape_f32(
-            kind,
-            variance as f32,
-            matern_tau_jitter,
-            tg,
-            &mut k32[cols],
-            kdg,
-        );
+        let variance = p.variance as f32;
+        apply_shape_f32(p.kind, variance, p.tau_jitter, tg, &mut k32[cols], kdg);
     }
 }
 
@@ -539,45 +537,75 @@ mod tests {
         (a.to_bits() as i64 - b.to_bits() as i64).unsigned_abs()
     }
 
+    /// Inducing inputs `z` (`M × D`), inverse lengthscales, points (`N × D`) and both scaled.
+    struct Case {
+        z: Vec<f64>,
+        inv_len: Vec<f64>,
+        pts: Vec<f64>,
+        zt: Vec<f64>,
+        xs: Vec<f64>,
+    }
+
+    const M: usize = 13;
+    const D: usize = 5;
+    const DX: usize = 3;
+    const GROUP: usize = 3;
+
+    /// Random inputs and `n` points in groups of [`GROUP`] that share coordinates `D_x..D`;
+    /// `place` edits the points before the groups take their first point's shared coordinates.
+    fn case(seed: u64, n: usize, place: impl FnOnce(&mut [f64], &[f64])) -> Case {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+        let z: Vec<f64> = (0..M * D).map(|_| rng.random_range(-2.0..2.0)).collect();
+        let inv_len: Vec<f64> = (0..D).map(|_| rng.random_range(0.5..2.0)).collect();
+        let mut pts: Vec<f64> = (0..n * D).map(|_| rng.random_range(-2.0..2.0)).collect();
+        place(&mut pts, &z);
+        for c in 0..n {
+            let first = (c / GROUP) * GROUP;
+            for j in DX..D {
+                pts[c * D + j] = pts[first * D + j];
+            }
+        }
+        let mut zt = vec![0.0; D * M];
+        scale_inducing(&z, &inv_len, &mut zt);
+        let mut xs = vec![0.0; D * n];
+        scale_points(&pts, &inv_len, &mut xs);
+        Case {
+            z,
+            inv_len,
+            pts,
+            zt,
+            xs,
+        }
+    }
+
+    impl Case {
+        fn points(&self, kind: KernelKind) -> GroupedPoints<'_> {
+            GroupedPoints {
+                kind,
+                variance: 0.7,
+                tau_jitter: 1e-8,
+                zt: &self.zt,
+                xs: &self.xs,
+                d: D,
+                shared_from: DX,
+                group: GROUP,
+            }
+        }
+    }
+
     /// The grouped kernel (shared input part computed once per group) against the direct
     /// elementwise formula `σ_f² g(Σ_j (z_j − x_j)²/ℓ_j²)` with libm `exp`.
     #[test]
     fn grouped_cross_cov_matches_direct_formula() {
-        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(4);
-        let (m, d, dx, group, n) = (13, 5, 3, 3, 6);
-        let z: Vec<f64> = (0..m * d).map(|_| rng.random_range(-2.0..2.0)).collect();
-        let inv_len: Vec<f64> = (0..d).map(|_| rng.random_range(0.5..2.0)).collect();
-        let mut pts: Vec<f64> = (0..n * d).map(|_| rng.random_range(-2.0..2.0)).collect();
-        for c in 0..n {
-            let first = (c / group) * group;
-            for j in dx..d {
-                pts[c * d + j] = pts[first * d + j];
-            }
-        }
-        let mut zt = vec![0.0; d * m];
-        scale_inducing(&z, &inv_len, &mut zt);
-        let mut xs = vec![0.0; d * n];
-        scale_points(&pts, &inv_len, &mut xs);
+        let n = 6;
+        let c = case(4, n, |_, _| {});
         for kind in [KernelKind::Matern32, KernelKind::SquaredExponential] {
-            let (mut k, mut kd) = (vec![0.0; m * n], vec![0.0; m * n]);
-            let mut scratch = vec![0.0; m];
-            let args = (kind, 0.7, 1e-8, &zt, &xs, d);
-            cross_cov_grouped(
-                args.0,
-                args.1,
-                args.2,
-                args.3,
-                args.4,
-                args.5,
-                (dx, group),
-                &mut k,
-                &mut kd,
-                &mut scratch,
-            );
-            for c in 0..n {
-                for i in 0..m {
-                    let tau: f64 = (0..d)
-                        .map(|j| ((z[i * d + j] - pts[c * d + j]) * inv_len[j]).powi(2))
+            let (mut k, mut kd, mut shared) = (vec![0.0; M * n], vec![0.0; M * n], vec![0.0; M]);
+            cross_cov_grouped(c.points(kind), &mut k, &mut kd, &mut shared);
+            for p in 0..n {
+                for i in 0..M {
+                    let tau: f64 = (0..D)
+                        .map(|j| ((c.z[i * D + j] - c.pts[p * D + j]) * c.inv_len[j]).powi(2))
                         .sum();
                     let (g, dg) = match kind {
                         KernelKind::Matern32 => {
@@ -588,8 +616,8 @@ mod tests {
                             ((-0.5 * tau).exp(), -0.5 * (-0.5 * tau).exp())
                         }
                     };
-                    assert!((k[c * m + i] - 0.7 * g).abs() < 1e-14, "{kind:?} K");
-                    assert!((kd[c * m + i] - 0.7 * dg).abs() < 1e-14, "{kind:?} K'");
+                    assert!((k[p * M + i] - 0.7 * g).abs() < 1e-14, "{kind:?} K");
+                    assert!((kd[p * M + i] - 0.7 * dg).abs() < 1e-14, "{kind:?} K'");
                 }
             }
         }
@@ -600,74 +628,26 @@ mod tests {
     /// (a far point); the same `K` with and without the derivative.
     #[test]
     fn f32_shape_matches_the_f64_kernel() {
-        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(6);
-        let (m, d, dx, group, n) = (13, 5, 3, 3, 7);
-        let z: Vec<f64> = (0..m * d).map(|_| rng.random_range(-2.0..2.0)).collect();
-        let inv_len: Vec<f64> = (0..d).map(|_| rng.random_range(0.5..2.0)).collect();
-        let mut pts: Vec<f64> = (0..n * d).map(|_| rng.random_range(-2.0..2.0)).collect();
+        let n = 7;
         // A far point (first group) and one on the first inducing input (second group).
-        pts[..d].iter_mut().for_each(|p| *p = 40.0);
-        pts[group * d..(group + 1) * d].copy_from_slice(&z[..d]);
-        for c in 0..n {
-            let first = (c / group) * group;
-            for j in dx..d {
-                pts[c * d + j] = pts[first * d + j];
-            }
-        }
-        let mut zt = vec![0.0; d * m];
-        scale_inducing(&z, &inv_len, &mut zt);
-        let mut xs = vec![0.0; d * n];
-        scale_points(&pts, &inv_len, &mut xs);
+        let c = case(6, n, |pts, z| {
+            pts[..D].iter_mut().for_each(|p| *p = 40.0);
+            pts[GROUP * D..(GROUP + 1) * D].copy_from_slice(&z[..D]);
+        });
         for kind in [KernelKind::Matern32, KernelKind::SquaredExponential] {
-            let (mut k, mut kd, mut shared) = (vec![0.0; m * n], vec![0.0; m * n], vec![0.0; m]);
-            let args = (kind, 0.7, 1e-8, &zt[..], &xs[..], d, (dx, group));
-            cross_cov_grouped(
-                args.0,
-                args.1,
-                args.2,
-                args.3,
-                args.4,
-                args.5,
-                args.6,
-                &mut k,
-                &mut kd,
-                &mut shared,
-            );
-            let (mut tau, mut k32, mut kd32) =
-                (vec![0.0; m * n], vec![0.0f32; m * n], vec![0.0; m * n]);
-            let mut values = vec![0.0f32; m * n];
-            cross_cov_grouped_f32(
-                args.0,
-                args.1,
-                args.2,
-                args.3,
-                args.4,
-                args.5,
-                args.6,
-                &mut tau,
-                &mut k32,
-                Some(&mut kd32),
-                &mut shared,
-            );
-            cross_cov_grouped_f32(
-                args.0,
-                args.1,
-                args.2,
-                args.3,
-                args.4,
-                args.5,
-                args.6,
-                &mut tau,
-                &mut values,
-                None,
-                &mut shared,
-            );
+            let (mut k, mut kd, mut shared) = (vec![0.0; M * n], vec![0.0; M * n], vec![0.0; M]);
+            cross_cov_grouped(c.points(kind), &mut k, &mut kd, &mut shared);
+            let (mut tau, mut kd32) = (vec![0.0; M * n], vec![0.0; M * n]);
+            let (mut k32, mut values) = (vec![0.0f32; M * n], vec![0.0f32; M * n]);
+            let points = c.points(kind);
+            cross_cov_grouped_f32(points, &mut tau, &mut k32, Some(&mut kd32), &mut shared);
+            cross_cov_grouped_f32(points, &mut tau, &mut values, None, &mut shared);
             assert_eq!(values, k32, "{kind:?}: with and without the derivative");
             // The argument's rounding moves `e^{−r}` by `r·2⁻²⁴` relative, and `r e^{−r} ≤ 1/e`:
             // errors are bounded in units of `σ_f²`, and relative ones where `K` is large.
             let eps = f64::from(f32::EPSILON);
             let mut floored = 0;
-            for i in 0..m * n {
+            for i in 0..M * n {
                 let (dk, dkd) = (f64::from(k32[i]) - k[i], kd32[i] - kd[i]);
                 if k[i] < F32_OPERAND_FLOOR {
                     assert_eq!(k32[i], 0.0, "{kind:?} {i}");
@@ -680,8 +660,9 @@ mod tests {
                 }
             }
             assert!(floored > 0, "{kind:?}: the far point reaches the floor");
+            let at_z = k32[GROUP * M];
             assert!(
-                (k32[group * m] - 0.7).abs() < 1e-6,
+                (at_z - 0.7).abs() < 1e-6,
                 "{kind:?}: K at an inducing input"
             );
         }

@@ -37,9 +37,10 @@ mod workspace;
 pub(crate) use predictive::PredictiveWorkspace;
 pub use workspace::{ConditionalGrads, ConditionalWorkspace, tape_len};
 
+use faer::traits::ComplexField;
 use faer::{Accum, MatRef};
 
-use crate::kernel::{self, KernelKind};
+use crate::kernel::{self, GroupedPoints, KernelKind};
 use crate::linalg::{
     cholesky_backward, cholesky_in_place, f32_operand, gemm, lower_inverse, view, view_mut,
     widen_into,
@@ -172,6 +173,21 @@ impl Posterior {
         })
     }
 
+    /// The kernel's operands for the scaled points `xs` (`D × N`) whose consecutive groups of
+    /// `group` share the input part `u` (rows `D_x..D`).
+    pub(crate) fn grouped<'a>(&'a self, xs: &'a [f64], group: usize) -> GroupedPoints<'a> {
+        GroupedPoints {
+            kind: self.kind,
+            variance: self.variance,
+            tau_jitter: self.tau_jitter,
+            zt: &self.zt,
+            xs,
+            d: self.d,
+            shared_from: self.dx,
+            group: group.max(1),
+        }
+    }
+
     /// `[G; mᵀG]` (`(M + D_x) × M`).
     #[inline]
     pub(crate) fn g_mean(&self) -> MatRef<'_, f64> {
@@ -231,14 +247,7 @@ impl Posterior {
 /// The forward product `[W; μ] = [G; mᵀG] K` of `n` points into `wm` (`(M + D_x) × N`), in
 /// `f64`.
 pub(crate) fn forward_product(post: &Posterior, k: &[f64], n: usize, wm: &mut [f64]) {
-    let (m, r) = (post.m, post.m + post.dx);
-    gemm(
-        view_mut(wm, r, n),
-        Accum::Replace,
-        post.g_mean(),
-        view(k, m, n),
-        1.0,
-    );
+    stacked_product(post.g_mean(), k, n, wm);
 }
 
 /// [`forward_product`] in `f32` for a mixed posterior ([`crate::precision`]), from the `f32`
@@ -250,15 +259,26 @@ pub(crate) fn forward_product_f32(
     wm: &mut [f64],
     wm32: &mut [f32],
 ) {
-    let (m, r) = (post.m, post.m + post.dx);
-    gemm(
-        view_mut(wm32, r, n),
-        Accum::Replace,
-        post.g_mean32(),
-        view(k32, m, n),
-        1.0,
-    );
+    let r = post.m + post.dx;
+    stacked_product(post.g_mean32(), k32, n, wm32);
     widen_into(&wm32[..r * n], wm, Accum::Replace);
+}
+
+/// `out = [G; mᵀG] K` for the first `n` columns of `k` (`M × N`), in `f64` or `f32`.
+fn stacked_product<T: ComplexField + From<f32>>(
+    g_mean: MatRef<'_, T>,
+    k: &[T],
+    n: usize,
+    out: &mut [T],
+) {
+    let (r, m) = (g_mean.nrows(), g_mean.ncols());
+    gemm(
+        view_mut(out, r, n),
+        Accum::Replace,
+        g_mean,
+        view(k, m, n),
+        T::from(1.0),
+    );
 }
 
 #[cfg(test)]

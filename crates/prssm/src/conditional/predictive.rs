@@ -71,45 +71,20 @@ impl PredictiveWorkspace {
         debug_assert!(n <= self.cap);
         let r = m + dx;
         kernel::scale_points(&self.input[..d * n], &post.inv_len, &mut self.xs[..d * n]);
-        let args = (post.kind, post.variance, post.tau_jitter, &post.zt[..]);
-        let xs = &self.xs[..d * n];
-        let group = (dx, self.group);
+        let points = post.grouped(&self.xs[..d * n], self.group);
         let (w2, var) = (&mut self.w2, &mut self.var);
         match self.mixed.as_mut() {
             None => {
                 let k = &mut self.k[..m * n];
-                let (kind, variance, jitter, zt) = args;
-                kernel::cross_cov_grouped_values(
-                    kind,
-                    variance,
-                    jitter,
-                    zt,
-                    xs,
-                    d,
-                    group,
-                    k,
-                    &mut self.tau_shared,
-                );
+                kernel::cross_cov_grouped_values(points, k, &mut self.tau_shared);
                 forward_product(post, k, n, &mut self.wm);
                 let h = (!post.whitened).then_some(&*k);
                 write_predictive_variance(post, &self.wm, r, h, n, w2, var, None, None);
             }
             Some([k32, wm32, var32, w2_32]) => {
                 // `self.k` holds `τ`; `K` exists only in `f32`.
-                let (kind, variance, jitter, zt) = args;
-                kernel::cross_cov_grouped_f32(
-                    kind,
-                    variance,
-                    jitter,
-                    zt,
-                    xs,
-                    d,
-                    group,
-                    &mut self.k,
-                    k32,
-                    None,
-                    &mut self.tau_shared,
-                );
+                let tau = &mut self.k;
+                kernel::cross_cov_grouped_f32(points, tau, k32, None, &mut self.tau_shared);
                 forward_product_f32(post, k32, n, &mut self.wm, wm32);
                 let h = (!post.whitened).then_some(&k32[..m * n]);
                 let mixed = Some((&mut w2_32[..], &mut var32[..]));

@@ -207,43 +207,20 @@ impl ConditionalWorkspace {
         let t = split_tape(post, self.cap, n, tape);
         let k = &mut self.k[..m * n];
         kernel::scale_points(&self.input[..d * n], &post.inv_len, t.xs);
-        let (kind, variance, jitter, zt) = (post.kind, post.variance, post.tau_jitter, &post.zt);
-        let group = (dx, self.input_group.max(1));
+        let points = post.grouped(t.xs, self.input_group);
         let r = m + dx;
         let (w2, var) = (&mut self.w2, &mut self.var);
         match self.mixed.as_mut() {
             None => {
-                kernel::cross_cov_grouped(
-                    kind,
-                    variance,
-                    jitter,
-                    zt,
-                    t.xs,
-                    d,
-                    group,
-                    k,
-                    t.kd,
-                    &mut self.rowsum,
-                );
+                kernel::cross_cov_grouped(points, k, t.kd, &mut self.rowsum);
                 forward_product(post, k, n, t.wm);
                 let h = (!post.whitened).then_some(&*k);
                 write_predictive_variance(post, t.wm, r, h, n, w2, var, Some(t.quad), None);
             }
             Some(mx) => {
                 // `k` holds `τ`; `K` exists only in `f32`. `mx.y` is scratch until the reverse.
-                kernel::cross_cov_grouped_f32(
-                    kind,
-                    variance,
-                    jitter,
-                    zt,
-                    t.xs,
-                    d,
-                    group,
-                    k,
-                    &mut mx.k,
-                    Some(t.kd),
-                    &mut self.rowsum,
-                );
+                let kd = Some(&mut *t.kd);
+                kernel::cross_cov_grouped_f32(points, k, &mut mx.k, kd, &mut self.rowsum);
                 forward_product_f32(post, &mx.k, n, t.wm, &mut mx.wm);
                 let h = (!post.whitened).then_some(&mx.k[..m * n]);
                 let mixed = Some((&mut mx.y[..], &mut mx.var[..]));
