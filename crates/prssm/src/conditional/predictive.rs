@@ -20,6 +20,7 @@ pub(crate) struct PredictiveWorkspace {
     /// GP inputs `[x; u]`, column-major `D × N` (filled by the caller).
     pub input: Vec<f64>,
     xs: Vec<f64>,
+    /// `K` (`M × N`), or `τ` under [`Precision::Mixed`] (`K` is then in `f32`).
     k: Vec<f64>,
     /// `[W; μ]`, column-major `(M + D_x) × N`.
     wm: Vec<f64>,
@@ -97,7 +98,8 @@ impl PredictiveWorkspace {
 /// Writes the predictive variances of `n` points into `var` (`D_x × N`, column-major):
 /// `σ²_d(n) = k** − w_nᵀh_n + Σ_i S_d,ii w_in²` (diagonal `S`) or `+ ‖L_dᵀw_n‖²` (full
 /// `S_d = L_dL_dᵀ`), with `w_n` the first `M` entries of column `n` of `w` (column stride
-/// `stride ≥ M`) and `h_n = k_n` (column `n` of `k`, `M × N`) or `w_n` when `k` is `None`
+/// `stride ≥ M`) and `h_n = k_n` (column `n` of `k`, `M × N`, in `f64` or, under mixed
+/// precision, the `f32` kernel; the sum is `f64` either way) or `w_n` when `k` is `None`
 /// (whitened). With `quad`, also writes `σ²_d(n) − k** = Σ_i … − w_nᵀh_n` there (`D_x × N`).
 /// `w2` (`M × N`) is scratch. With `mixed` (`M × N` and `D_x × N` scratch) and a mixed
 /// posterior of diagonal `S`, the sum `S(W⊙W)` of positive terms is formed in `f32`.

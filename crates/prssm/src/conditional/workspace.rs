@@ -45,7 +45,8 @@ pub struct ConditionalWorkspace {
     /// GP inputs `[x; u]`, column-major `D × N` (filled by the caller).
     pub input: Vec<f64>,
     tape: Vec<f64>,
-    /// `K` of the current step (`M × N`; not on the tape).
+    /// `K` of the current step (`M × N`; not on the tape), or its `τ` under
+    /// [`Precision::Mixed`] (`K` is then in `f32`).
     k: Vec<f64>,
     w2: Vec<f64>,
     wbar: Vec<f64>,
