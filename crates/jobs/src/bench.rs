@@ -98,17 +98,19 @@ impl BenchReport {
     /// limit of the timed precision: the f64 one for `f64`), s.
     pub fn precision_flop_limit_epoch_s(&self) -> f64 {
         let gflop = self.epoch_s * self.train_gflops;
-        let per_core = self.train_f32_share / self.gemm_f32_gflops
-            + (1.0 - self.train_f32_share) / self.gemm_gflops;
-        gflop * per_core / self.threads as f64
+        gflop * self.seconds_per_gflop(self.train_f32_share) / self.threads as f64
     }
 
     /// Prediction time if every FLOP ran at the one-thread GEMM rate of its precision, s.
     pub fn precision_flop_limit_predict_s(&self) -> f64 {
         let gflop = self.predict_s * self.predict_gflops;
-        gflop
-            * (self.predict_f32_share / self.gemm_f32_gflops
-                + (1.0 - self.predict_f32_share) / self.gemm_gflops)
+        gflop * self.seconds_per_gflop(self.predict_f32_share)
+    }
+
+    /// Seconds one core takes per GFLOP at the GEMM rates when `f32_share` of the FLOP run
+    /// in `f32` and the rest in `f64`.
+    fn seconds_per_gflop(&self, f32_share: f64) -> f64 {
+        f32_share / self.gemm_f32_gflops + (1.0 - f32_share) / self.gemm_gflops
     }
 }
 

@@ -251,12 +251,12 @@ pub(crate) fn cross_cov_grouped_f32(
     let tau_shared = &mut tau_shared[..m_n];
     let n = p.xs.len() / p.d;
     let (tau, k32) = (&mut tau[..m_n * n], &mut k32[..m_n * n]);
+    let variance = p.variance as f32;
     for (g, xg) in p.xs.chunks(p.d * group).enumerate() {
         let cols = g * m_n * group..((g + 1) * m_n * group).min(m_n * n);
         let tg = &mut tau[cols.clone()];
         p.group_tau(xg, tau_shared, tg);
         let kdg = kd.as_deref_mut().map(|kd| &mut kd[cols.clone()]);
-        let variance = p.variance as f32;
         apply_shape_f32(p.kind, variance, p.tau_jitter, tg, &mut k32[cols], kdg);
     }
 }

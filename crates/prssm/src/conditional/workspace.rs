@@ -73,7 +73,7 @@ struct MixedBuffers {
     wm: Vec<f32>,
     /// `[P; μ̄]`, then `[A; μ̄]` (`(M + D_x) × N`).
     wbar: Vec<f32>,
-    /// `Y` (`M × N`).
+    /// `Y` (`M × N`); in the forward pass, the scratch of `W⊙W`.
     y: Vec<f32>,
     /// This step's `[A; μ̄] Wᵀ` (`(M + D_x) × M`).
     gbar: Vec<f32>,
