@@ -22,7 +22,7 @@ use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
 use flapssm_prssm::PrssmModel;
-use flapssm_prssm::train::{BestBy, Checkpoint, LrSchedule};
+use flapssm_prssm::train::{BestBy, Checkpoint, LrSchedule, TrainConfig};
 use flapssm_qs::{EnetOptions, LrqsmModel};
 use flapssm_wing::dataset::{OUTPUT_NAMES, ValidDataset};
 use flapssm_wing::features::FeatureSet;
@@ -460,7 +460,14 @@ pub fn run_demo(
             path: ck_path.clone(),
             source: std::io::Error::other(e.to_string()),
         })?
-        .filter(|ck| ck.config == plan.spec().train);
+        // The plan's configuration has no run context (model, ELBO options, data fingerprint):
+        // `fit` adds it, and the trainer refuses a checkpoint of another context by name.
+        .filter(|ck| {
+            TrainConfig {
+                run_context: serde_json::Value::Null,
+                ..ck.config.clone()
+            } == plan.spec().train
+        });
         if !run.up_to_date("prssm", &k_pm, &[&pm_path]) {
             run.stages.stages.insert(
                 started_key.into(),
@@ -720,6 +727,78 @@ mod tests {
         assert_eq!(spec.windows_per_task, 2);
         let tasks = spec.train.batch_size.div_ceil(spec.windows_per_task);
         assert_eq!(tasks, 2);
+    }
+
+    /// Stops the demo's training at step `at` (through the stop flag) and keeps its lines.
+    struct StopAt<'a> {
+        at: u64,
+        stop: &'a AtomicBool,
+        lines: std::sync::Mutex<Vec<String>>,
+    }
+
+    impl Progress for StopAt<'_> {
+        fn set(&self, pos: u64, _total: u64) {
+            if pos >= self.at {
+                self.stop.store(true, std::sync::atomic::Ordering::Relaxed);
+            }
+        }
+        fn println(&self, line: &str) {
+            self.lines.lock().unwrap().push(line.into());
+        }
+    }
+
+    /// A demo stopped in its training resumes from its checkpoint when run again, and ends
+    /// with the model files of an uninterrupted run. Regression: the rerun started the
+    /// training over, because the checkpoint's configuration carries the run context that the
+    /// plan's lacks.
+    #[test]
+    fn a_stopped_demo_resumes_to_the_uninterrupted_result() {
+        let mut cfg = DemoConfig::default_for(5);
+        cfg.simulation.trajectories.n_trajectories = 8;
+        cfg.simulation.trajectories.n_train = 7;
+        cfg.simulation.wing.fidelity = flapssm_wing::virtual_wing::Fidelity::L0;
+        cfg.training.epochs = Some(4);
+        cfg.training.inducing = Some(8);
+        cfg.training.particles = Some(4);
+        cfg.evaluation.particles = 4;
+        let tmp = tempfile::tempdir().unwrap();
+        let (whole, stopped) = (tmp.path().join("whole"), tmp.path().join("stopped"));
+        run_demo(&whole, &cfg, &NoProgress, None).unwrap();
+
+        let stop = AtomicBool::new(false);
+        let progress = StopAt {
+            at: 3,
+            stop: &stop,
+            lines: Default::default(),
+        };
+        let e = run_demo(&stopped, &cfg, &progress, Some(&stop)).unwrap_err();
+        assert!(matches!(e, JobError::Interrupted { step: 3, .. }), "{e}");
+        assert!(stopped.join("prssm.ckpt.json").exists());
+        assert!(!stopped.join("prssm.json").exists());
+        run_demo(&stopped, &cfg, &progress, None).unwrap();
+        let lines = progress.lines.lock().unwrap();
+        assert!(lines.iter().any(|l| l == "resuming at step 3"), "{lines:?}");
+        for file in ["prssm.json", "prssm.last.json", "prssm.curve.csv"] {
+            let read = |dir: &Path| std::fs::read(dir.join(file)).unwrap();
+            if file.ends_with(".csv") {
+                // Wall times differ; the steps and values do not.
+                let rows = |dir: &Path| -> Vec<String> {
+                    String::from_utf8(read(dir))
+                        .unwrap()
+                        .lines()
+                        .map(|l| {
+                            let c: Vec<&str> = l.split(',').collect();
+                            [&c[..2.min(c.len())], &c[3.min(c.len())..]]
+                                .concat()
+                                .join(",")
+                        })
+                        .collect()
+                };
+                assert_eq!(rows(&stopped), rows(&whole), "{file}");
+            } else {
+                assert!(read(&stopped) == read(&whole), "{file} differs");
+            }
+        }
     }
 
     /// `--full --preset paper-fast` changes the training schedule only: the paper's model,

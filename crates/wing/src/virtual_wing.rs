@@ -131,7 +131,7 @@ pub enum SimulateError {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct VirtualWingConfig {
-    /// Aerodynamic fidelity (L2).
+    /// Aerodynamic fidelity (L3).
     pub fidelity: Fidelity,
     /// Plate geometry (0.18 × 0.06 m, r0 = 0.055 m, pitch axis at 15 % chord, U_ref at 0.235 m).
     pub wing: WingGeometry,
