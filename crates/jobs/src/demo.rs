@@ -648,6 +648,7 @@ fn summarize(
 mod tests {
     use super::*;
     use crate::progress::NoProgress;
+    use flapssm_prssm::Precision;
 
     /// A bad setting of any part fails before the demo creates its directory, naming the setting.
     #[test]
@@ -748,9 +749,9 @@ mod tests {
     }
 
     /// A demo stopped in its training resumes from its checkpoint when run again, and ends
-    /// with the model files of an uninterrupted run. Regression: the rerun started the
-    /// training over, because the checkpoint's configuration carries the run context that the
-    /// plan's lacks.
+    /// with the model files of an uninterrupted run, in either precision. Regression: the
+    /// rerun started the training over, because the checkpoint's configuration carries the run
+    /// context that the plan's lacks.
     #[test]
     fn a_stopped_demo_resumes_to_the_uninterrupted_result() {
         let mut cfg = DemoConfig::default_for(5);
@@ -762,42 +763,50 @@ mod tests {
         cfg.training.particles = Some(4);
         cfg.evaluation.particles = 4;
         let tmp = tempfile::tempdir().unwrap();
-        let (whole, stopped) = (tmp.path().join("whole"), tmp.path().join("stopped"));
-        run_demo(&whole, &cfg, &NoProgress, None).unwrap();
+        for precision in [Precision::F64, Precision::Mixed] {
+            cfg.training.precision = Some(precision);
+            let name = format!("{precision:?}");
+            let whole = tmp.path().join(format!("{name}-whole"));
+            let stopped = tmp.path().join(format!("{name}-stopped"));
+            run_demo(&whole, &cfg, &NoProgress, None).unwrap();
 
-        let stop = AtomicBool::new(false);
-        let progress = StopAt {
-            at: 3,
-            stop: &stop,
-            lines: Default::default(),
-        };
-        let e = run_demo(&stopped, &cfg, &progress, Some(&stop)).unwrap_err();
-        assert!(matches!(e, JobError::Interrupted { step: 3, .. }), "{e}");
-        assert!(stopped.join("prssm.ckpt.json").exists());
-        assert!(!stopped.join("prssm.json").exists());
-        run_demo(&stopped, &cfg, &progress, None).unwrap();
-        let lines = progress.lines.lock().unwrap();
-        assert!(lines.iter().any(|l| l == "resuming at step 3"), "{lines:?}");
-        for file in ["prssm.json", "prssm.last.json", "prssm.curve.csv"] {
-            let read = |dir: &Path| std::fs::read(dir.join(file)).unwrap();
-            if file.ends_with(".csv") {
-                // Wall times differ; the steps and values do not.
-                let rows = |dir: &Path| -> Vec<String> {
-                    String::from_utf8(read(dir))
-                        .unwrap()
-                        .lines()
-                        .map(|l| {
-                            let c: Vec<&str> = l.split(',').collect();
-                            [&c[..2.min(c.len())], &c[3.min(c.len())..]]
-                                .concat()
-                                .join(",")
-                        })
-                        .collect()
-                };
-                assert_eq!(rows(&stopped), rows(&whole), "{file}");
-            } else {
-                assert!(read(&stopped) == read(&whole), "{file} differs");
+            let stop = AtomicBool::new(false);
+            let progress = StopAt {
+                at: 3,
+                stop: &stop,
+                lines: Default::default(),
+            };
+            let e = run_demo(&stopped, &cfg, &progress, Some(&stop)).unwrap_err();
+            assert!(matches!(e, JobError::Interrupted { step: 3, .. }), "{e}");
+            assert!(stopped.join("prssm.ckpt.json").exists());
+            assert!(!stopped.join("prssm.json").exists());
+            run_demo(&stopped, &cfg, &progress, None).unwrap();
+            let lines = progress.lines.lock().unwrap();
+            assert!(
+                lines.iter().any(|l| l == "resuming at step 3"),
+                "{name}: {lines:?}"
+            );
+            let read = |dir: &Path, file: &str| std::fs::read(dir.join(file)).unwrap();
+            for file in ["prssm.json", "prssm.last.json"] {
+                assert!(
+                    read(&stopped, file) == read(&whole, file),
+                    "{name}: {file} differs"
+                );
             }
+            // The learning curve: the same steps and values; the wall times differ.
+            let rows = |dir: &Path| -> Vec<String> {
+                String::from_utf8(read(dir, "prssm.curve.csv"))
+                    .unwrap()
+                    .lines()
+                    .map(|l| {
+                        let c: Vec<&str> = l.split(',').collect();
+                        [&c[..2.min(c.len())], &c[3.min(c.len())..]]
+                            .concat()
+                            .join(",")
+                    })
+                    .collect()
+            };
+            assert_eq!(rows(&stopped), rows(&whole), "{name}: learning curve");
         }
     }
 
