@@ -434,7 +434,7 @@ fn trailing_edge_leads_as_often_as_in_the_papers_trajectories() {
 
 /// The memory figures of the normal-force wing on a flat stroke plane with L2 (strip vortex)
 /// data, for the record (docs/vortex-method.md; the default wing's are printed by
-/// `default_generator_memory_evidence`). A study, not a check:
+/// `default_wing_memory_evidence`). A study, not a check:
 /// `cargo test --release -p flapssm-wing --test memory -- --ignored --nocapture`.
 #[test]
 #[ignore = "study: prints the L2 memory figures of the flat normal-force wing (≈ 10 s)"]
