@@ -647,7 +647,7 @@ fn summarize(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::progress::NoProgress;
+    use crate::progress::{NoProgress, StopAfter};
     use flapssm_prssm::Precision;
 
     /// A bad setting of any part fails before the demo creates its directory, naming the setting.
@@ -730,24 +730,6 @@ mod tests {
         assert_eq!(tasks, 2);
     }
 
-    /// Stops the demo's training at step `at` (through the stop flag) and keeps its lines.
-    struct StopAt<'a> {
-        at: u64,
-        stop: &'a AtomicBool,
-        lines: std::sync::Mutex<Vec<String>>,
-    }
-
-    impl Progress for StopAt<'_> {
-        fn set(&self, pos: u64, _total: u64) {
-            if pos >= self.at {
-                self.stop.store(true, std::sync::atomic::Ordering::Relaxed);
-            }
-        }
-        fn println(&self, line: &str) {
-            self.lines.lock().unwrap().push(line.into());
-        }
-    }
-
     /// A demo stopped in its training resumes from its checkpoint when run again, and ends
     /// with the model files of an uninterrupted run, in either precision. Regression: the
     /// rerun started the training over, because the checkpoint's configuration carries the run
@@ -771,11 +753,7 @@ mod tests {
             run_demo(&whole, &cfg, &NoProgress, None).unwrap();
 
             let stop = AtomicBool::new(false);
-            let progress = StopAt {
-                at: 3,
-                stop: &stop,
-                lines: Default::default(),
-            };
+            let progress = StopAfter::new(3, &stop);
             let e = run_demo(&stopped, &cfg, &progress, Some(&stop)).unwrap_err();
             assert!(matches!(e, JobError::Interrupted { step: 3, .. }), "{e}");
             assert!(stopped.join("prssm.ckpt.json").exists());

@@ -22,3 +22,35 @@ pub trait Progress: Sync {
 #[derive(Debug, Clone, Copy, Default)]
 pub struct NoProgress;
 impl Progress for NoProgress {}
+
+/// A [`Progress`] for tests: sets `stop` once the training has taken `after` steps, and keeps
+/// the lines printed.
+#[cfg(test)]
+pub(crate) struct StopAfter<'a> {
+    pub after: u64,
+    pub stop: &'a std::sync::atomic::AtomicBool,
+    pub lines: std::sync::Mutex<Vec<String>>,
+}
+
+#[cfg(test)]
+impl<'a> StopAfter<'a> {
+    pub fn new(after: u64, stop: &'a std::sync::atomic::AtomicBool) -> Self {
+        Self {
+            after,
+            stop,
+            lines: std::sync::Mutex::default(),
+        }
+    }
+}
+
+#[cfg(test)]
+impl Progress for StopAfter<'_> {
+    fn set(&self, pos: u64, _total: u64) {
+        if pos >= self.after {
+            self.stop.store(true, std::sync::atomic::Ordering::SeqCst);
+        }
+    }
+    fn println(&self, line: &str) {
+        self.lines.lock().unwrap().push(line.into());
+    }
+}

@@ -601,22 +601,9 @@ impl SweepTable {
 mod tests {
     use super::*;
     use crate::progress::NoProgress;
+    use crate::progress::StopAfter;
     use crate::test_data::tiny_dataset;
     use flapssm_prssm::train::fit::Preset;
-    use std::sync::atomic::Ordering;
-
-    /// Sets `stop` once the training has taken `after` steps.
-    struct StopAfter<'a> {
-        after: u64,
-        stop: &'a AtomicBool,
-    }
-    impl Progress for StopAfter<'_> {
-        fn set(&self, pos: u64, _total: u64) {
-            if pos >= self.after {
-                self.stop.store(true, Ordering::SeqCst);
-            }
-        }
-    }
 
     fn tiny_settings(dx: usize) -> SweepSettings {
         SweepSettings {
@@ -650,10 +637,7 @@ mod tests {
 
         let ckpt = dir.path().join("dx6.ckpt.json");
         let stop = AtomicBool::new(false);
-        let stopper = StopAfter {
-            after: 3,
-            stop: &stop,
-        };
+        let stopper = StopAfter::new(3, &stop);
         let err = sweep_run(&ds, "tiny", &plan, Some(&ckpt), true, &stopper, Some(&stop));
         assert!(
             matches!(err, Err(JobError::Interrupted { step: 3, .. })),
