@@ -238,13 +238,14 @@ pub(crate) fn cross_cov_grouped_values(p: GroupedPoints, k: &mut [f64], tau_shar
 /// [`cross_cov_grouped`] with the shape in `f32`, for the products of mixed precision
 /// ([`crate::precision`]): `τ` in `f64` into `tau` (`M × N`), then `k32 = σ_f² g(τ)` by
 /// [`exp_f32`] and the `f32` square root, as product operands (values below
-/// [`F32_OPERAND_FLOOR`] become zero), and, if `kd` is given, `σ_f² g'(τ)` widened into it.
-/// Within a few `f32` roundings of the `f64` values; twice the lanes of the `f64` shape.
+/// [`F32_OPERAND_FLOOR`] become zero), and, if `scaled_exp` is given, `σ_f² e^{x(τ)}` into
+/// it, from which `σ_f² g'(τ) = c' · σ_f² e^{x}` ([`shape_slope`]). Within a few `f32`
+/// roundings of the `f64` values; twice the lanes of the `f64` shape.
 pub(crate) fn cross_cov_grouped_f32(
     p: GroupedPoints,
     tau: &mut [f64],
     k32: &mut [f32],
-    mut kd: Option<&mut [f64]>,
+    mut scaled_exp: Option<&mut [f32]>,
     tau_shared: &mut [f64],
 ) {
     let (m_n, group) = (p.m(), p.group);
@@ -256,8 +257,8 @@ pub(crate) fn cross_cov_grouped_f32(
         let cols = g * m_n * group..((g + 1) * m_n * group).min(m_n * n);
         let tg = &mut tau[cols.clone()];
         p.group_tau(xg, tau_shared, tg);
-        let kdg = kd.as_deref_mut().map(|kd| &mut kd[cols.clone()]);
-        apply_shape_f32(p.kind, variance, p.tau_jitter, tg, &mut k32[cols], kdg);
+        let eg = scaled_exp.as_deref_mut().map(|e| &mut e[cols.clone()]);
+        apply_shape_f32(p.kind, variance, p.tau_jitter, tg, &mut k32[cols], eg);
     }
 }
 
@@ -369,11 +370,19 @@ fn apply_shape_values(kind: KernelKind, variance: f64, jitter: f64, k: &mut [f64
     }
 }
 
+/// `c'` of [`apply_shape_f32`]: `σ_f² g'(τ) = c' · σ_f² e^{x(τ)}` (`−3/2` for Matern-3/2,
+/// `−1/2` for the squared exponential).
+pub(crate) fn shape_slope(kind: KernelKind) -> f64 {
+    match kind {
+        KernelKind::Matern32 => -1.5,
+        KernelKind::SquaredExponential => -0.5,
+    }
+}
+
 /// `k[i] = σ_f² g(τ[i])` in `f32`, as a product operand (below [`F32_OPERAND_FLOOR`]: zero),
-/// and `kd[i] = σ_f² g'(τ[i])` if given: `g = c(p) e^{x(p)}` and `g' = c' e^{x(p)}` with
-/// `p = √(3(τ + δ))`, `x = −p`, `c = 1 + p`, `c' = −3/2` (Matern-3/2) or `p = −τ/2`, `x = p`,
-/// `c = 1`, `c' = −1/2` (squared exponential). `τ` is overwritten (its bytes hold the `f32`
-/// values `σ_f² e^{x}` for `kd`).
+/// and `scaled_exp[i] = σ_f² e^{x(p)}` if given: `g = c(p) e^{x(p)}` with `p = √(3(τ + δ))`,
+/// `x = −p`, `c = 1 + p` (Matern-3/2) or `p = −τ/2`, `x = p`, `c = 1` (squared exponential);
+/// `g' = c' e^{x(p)}` ([`shape_slope`]). `τ` is overwritten.
 #[inline]
 fn apply_shape_f32(
     kind: KernelKind,
@@ -381,51 +390,43 @@ fn apply_shape_f32(
     jitter: f64,
     tau: &mut [f64],
     k: &mut [f32],
-    kd: Option<&mut [f64]>,
+    scaled_exp: Option<&mut [f32]>,
 ) {
     match kind {
         KernelKind::Matern32 => shape_passes(
-            (tau, k, kd),
+            (tau, k, scaled_exp),
             variance,
             |t| ((3.0 * (t + jitter)) as f32).sqrt(),
             |p| (-p, 1.0 + p),
-            -1.5,
         ),
         KernelKind::SquaredExponential => shape_passes(
-            (tau, k, kd),
+            (tau, k, scaled_exp),
             variance,
             |t| (-0.5 * t) as f32,
             |p| (p, 1.0),
-            -0.5,
         ),
     }
 }
 
 /// The loops of [`apply_shape_f32`] as separate passes over slices of one type each, so that
 /// the `f32` work runs on 8 lanes and not on the 4 of `τ`'s `f64`: `p` narrowed into `k`,
-/// then `k` and `σ_f² eˣ` (into `τ`'s bytes), then `kd` widened.
+/// then `k` and `σ_f² eˣ`.
 #[inline(always)]
 fn shape_passes(
-    (tau, k, kd): (&mut [f64], &mut [f32], Option<&mut [f64]>),
+    (tau, k, scaled_exp): (&mut [f64], &mut [f32], Option<&mut [f32]>),
     variance: f32,
     p_of: impl Fn(f64) -> f32,
     x_c: impl Fn(f32) -> (f32, f32),
-    dc: f64,
 ) {
     let n = k.len();
     k.iter_mut().zip(&tau[..n]).for_each(|(k, &t)| *k = p_of(t));
-    match kd {
-        Some(kd) => {
-            let e: &mut [f32] = &mut bytemuck::cast_slice_mut(&mut tau[..n])[..n];
-            for (k, e) in k.iter_mut().zip(e.iter_mut()) {
+    match scaled_exp {
+        Some(e) => {
+            for (k, e) in k.iter_mut().zip(e[..n].iter_mut()) {
                 let (x, c) = x_c(*k);
                 *e = variance * exp_f32(x);
                 *k = operand(c * *e);
             }
-            kd[..n]
-                .iter_mut()
-                .zip(&*e)
-                .for_each(|(d, &e)| *d = dc * f64::from(e));
         }
         None => k.iter_mut().for_each(|k| {
             let (x, c) = x_c(*k);
@@ -637,10 +638,14 @@ mod tests {
         for kind in [KernelKind::Matern32, KernelKind::SquaredExponential] {
             let (mut k, mut kd, mut shared) = (vec![0.0; M * n], vec![0.0; M * n], vec![0.0; M]);
             cross_cov_grouped(c.points(kind), &mut k, &mut kd, &mut shared);
-            let (mut tau, mut kd32) = (vec![0.0; M * n], vec![0.0; M * n]);
+            let (mut tau, mut e32) = (vec![0.0; M * n], vec![0.0f32; M * n]);
             let (mut k32, mut values) = (vec![0.0f32; M * n], vec![0.0f32; M * n]);
             let points = c.points(kind);
-            cross_cov_grouped_f32(points, &mut tau, &mut k32, Some(&mut kd32), &mut shared);
+            cross_cov_grouped_f32(points, &mut tau, &mut k32, Some(&mut e32), &mut shared);
+            let kd32: Vec<f64> = e32
+                .iter()
+                .map(|&e| shape_slope(kind) * f64::from(e))
+                .collect();
             cross_cov_grouped_f32(points, &mut tau, &mut values, None, &mut shared);
             assert_eq!(values, k32, "{kind:?}: with and without the derivative");
             // The argument's rounding moves `e^{−r}` by `r·2⁻²⁴` relative, and `r e^{−r} ≤ 1/e`:

@@ -68,20 +68,20 @@ pub(crate) fn widen_into(src: &[f32], dst: &mut [f64], accum: Accum) {
 }
 
 /// `Σ aᵢbᵢ` in eight interleaved partial sums (vectorizes; fixed order, so deterministic);
-/// `b` in `f64` or widened from `f32`.
+/// `a` and `b` in `f64` or widened from `f32`.
 #[inline]
-pub(crate) fn dot<B: Copy + Into<f64>>(a: &[f64], b: &[B]) -> f64 {
+pub(crate) fn dot<A: Copy + Into<f64>, B: Copy + Into<f64>>(a: &[A], b: &[B]) -> f64 {
     let mut acc = [0.0; 8];
     let (ac, bc) = (a.chunks_exact(8), b.chunks_exact(8));
     let (ar, br) = (ac.remainder(), bc.remainder());
     for (x, y) in ac.zip(bc) {
         for l in 0..8 {
-            acc[l] = x[l].mul_add(y[l].into(), acc[l]);
+            acc[l] = x[l].into().mul_add(y[l].into(), acc[l]);
         }
     }
     let mut s = ((acc[0] + acc[4]) + (acc[1] + acc[5])) + ((acc[2] + acc[6]) + (acc[3] + acc[7]));
-    for (x, &y) in ar.iter().zip(br) {
-        s = x.mul_add(y.into(), s);
+    for (&x, &y) in ar.iter().zip(br) {
+        s = x.into().mul_add(y.into(), s);
     }
     s
 }

@@ -29,7 +29,10 @@
 //! Once per evaluation `B` (`M × M`) becomes `K̄_mm = −B` (unwhitened) or `L̄ = −tril(B)` and
 //! the Cholesky adjoint (whitened) in `Posterior::kmm_grad`. The reverse mode never reads
 //! `K`, so the tape holds `X̃`, `σ_f² g'`, `[W; μ]` and `σ² − σ_f²` but not `K`: a quarter less
-//! memory traffic, which is the largest cost of a step outside the products.
+//! memory traffic, which is the largest cost of a step outside the products. Under mixed
+//! precision the tape keeps `σ_f² eˣ` (`σ_f² g' = c′ σ_f² eˣ`) and `[W; μ]` in the `f32` the
+//! shape and the product formed them in, and the reverse mode widens them exactly as it reads
+//! them: the same values at half their traffic.
 
 mod predictive;
 mod workspace;
@@ -43,7 +46,6 @@ use faer::{Accum, MatRef};
 use crate::kernel::{self, GroupedPoints, KernelKind};
 use crate::linalg::{
     cholesky_backward, cholesky_in_place, f32_operand, gemm, lower_inverse, view, view_mut,
-    widen_into,
 };
 use crate::objective::ObjectiveError;
 use crate::params::{CovarianceStructure, ModelConfig, Parametrization, Params};
@@ -251,17 +253,9 @@ pub(crate) fn forward_product(post: &Posterior, k: &[f64], n: usize, wm: &mut [f
 }
 
 /// [`forward_product`] in `f32` for a mixed posterior ([`crate::precision`]), from the `f32`
-/// kernel `k32` (`M × N`): `[W; μ]` formed in `wm32` and widened into `wm`. Allocates nothing.
-pub(crate) fn forward_product_f32(
-    post: &Posterior,
-    k32: &[f32],
-    n: usize,
-    wm: &mut [f64],
-    wm32: &mut [f32],
-) {
-    let r = post.m + post.dx;
+/// kernel `k32` (`M × N`) into `wm32` (`(M + D_x) × N`). Allocates nothing.
+pub(crate) fn forward_product_f32(post: &Posterior, k32: &[f32], n: usize, wm32: &mut [f32]) {
     stacked_product(post.g_mean32(), k32, n, wm32);
-    widen_into(&wm32[..r * n], wm, Accum::Replace);
 }
 
 /// `out = [G; mᵀG] K` for the first `n` columns of `k` (`M × N`), in `f64` or `f32`.

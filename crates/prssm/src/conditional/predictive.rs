@@ -80,16 +80,17 @@ impl PredictiveWorkspace {
                 kernel::cross_cov_grouped_values(points, k, &mut self.tau_shared);
                 forward_product(post, k, n, &mut self.wm);
                 let h = (!post.whitened).then_some(&*k);
-                write_predictive_variance(post, &self.wm, r, h, n, w2, var, None, None);
+                write_predictive_variance(post, &self.wm, r, h, n, w2, var, None);
             }
             Some([k32, wm32, var32, w2_32]) => {
                 // `self.k` holds `τ`; `K` exists only in `f32`.
                 let tau = &mut self.k;
                 kernel::cross_cov_grouped_f32(points, tau, k32, None, &mut self.tau_shared);
-                forward_product_f32(post, k32, n, &mut self.wm, wm32);
+                forward_product_f32(post, k32, n, wm32);
+                widen_into(&wm32[..r * n], &mut self.wm, Accum::Replace);
                 let h = (!post.whitened).then_some(&k32[..m * n]);
                 let mixed = Some((&mut w2_32[..], &mut var32[..]));
-                write_predictive_variance(post, &self.wm, r, h, n, w2, var, None, mixed);
+                write_predictive_variance(post, &self.wm, r, h, n, w2, var, mixed);
             }
         }
     }
@@ -100,10 +101,9 @@ impl PredictiveWorkspace {
 /// `S_d = L_dL_dᵀ`), with `w_n` the first `M` entries of column `n` of `w` (column stride
 /// `stride ≥ M`) and `h_n = k_n` (column `n` of `k`, `M × N`, in `f64` or, under mixed
 /// precision, the `f32` kernel; the sum is `f64` either way) or `w_n` when `k` is `None`
-/// (whitened). With `quad`, also writes `σ²_d(n) − k** = Σ_i … − w_nᵀh_n` there (`D_x × N`).
-/// `w2` (`M × N`) is scratch. With `mixed` (`M × N` and `D_x × N` scratch) and a mixed
-/// posterior of diagonal `S`, the sum `S(W⊙W)` of positive terms is formed in `f32`.
-/// Allocates nothing.
+/// (whitened). `w2` (`M × N`) is scratch. With `mixed` (`M × N` and `D_x × N` scratch) and a
+/// mixed posterior of diagonal `S`, the sum `S(W⊙W)` of positive terms is formed in `f32`
+/// ([`write_quadratic_term_f32`]). Allocates nothing.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn write_predictive_variance<H: Copy + Into<f64>>(
     post: &Posterior,
@@ -113,28 +113,65 @@ pub(super) fn write_predictive_variance<H: Copy + Into<f64>>(
     n: usize,
     w2: &mut [f64],
     var: &mut [f64],
-    mut quad: Option<&mut [f64]>,
     mixed: Option<(&mut [f32], &mut [f32])>,
 ) {
-    let (m, dx) = (post.m, post.dx);
-    let w_view = view(&w[..stride * n], stride, n).subrows(0, m);
-    match (post.cov, mixed) {
-        (CovarianceStructure::Diagonal, Some((w2_32, var32))) if !post.q_cov32.is_empty() => {
-            for (c2, wc) in w2_32[..m * n].chunks_exact_mut(m).zip(w.chunks(stride)) {
-                c2.iter_mut().zip(&wc[..m]).for_each(|(a, &b)| {
-                    *a = f32_operand(b * b);
-                });
-            }
-            gemm(
-                view_mut(var32, dx, n),
-                Accum::Replace,
-                view(&post.q_cov32, dx, m),
-                view(w2_32, m, n),
-                1.0,
-            );
-            widen_into(&var32[..dx * n], var, Accum::Replace);
+    match mixed {
+        Some((w2_32, var32)) if uses_f32_quadratic_term(post) => {
+            write_quadratic_term_f32(post, w, stride, n, w2_32, var32, var)
         }
-        (CovarianceStructure::Diagonal, _) => {
+        _ => write_quadratic_term(post, w, stride, n, w2, var),
+    }
+    add_base_variance(post, w, stride, k, n, var, None);
+}
+
+/// Whether [`write_quadratic_term_f32`] serves `post`: mixed precision and diagonal `S`.
+pub(super) fn uses_f32_quadratic_term(post: &Posterior) -> bool {
+    post.cov == CovarianceStructure::Diagonal && !post.q_cov32.is_empty()
+}
+
+/// `var = S(W⊙W)` for diagonal `S` in `f32` (the operands `W⊙W` rounded into `w2_32`, the
+/// product into `var32`, widened into `var`), from `W` in `f64` or `f32` (first `M` rows of
+/// `w`, column stride `stride`). Allocates nothing.
+pub(super) fn write_quadratic_term_f32<W: Copy + Into<f64>>(
+    post: &Posterior,
+    w: &[W],
+    stride: usize,
+    n: usize,
+    w2_32: &mut [f32],
+    var32: &mut [f32],
+    var: &mut [f64],
+) {
+    let (m, dx) = (post.m, post.dx);
+    for (c2, wc) in w2_32[..m * n].chunks_exact_mut(m).zip(w.chunks(stride)) {
+        c2.iter_mut().zip(&wc[..m]).for_each(|(a, &b)| {
+            let b: f64 = b.into();
+            *a = f32_operand(b * b);
+        });
+    }
+    gemm(
+        view_mut(var32, dx, n),
+        Accum::Replace,
+        view(&post.q_cov32, dx, m),
+        view(w2_32, m, n),
+        1.0,
+    );
+    widen_into(&var32[..dx * n], var, Accum::Replace);
+}
+
+/// `var = Σ_i S_d,ii w_in²` (diagonal `S`) or `‖L_dᵀw_n‖²` (full `S`) in `f64`, from the
+/// first `M` rows of `w` (column stride `stride`); `w2` (`M × N`) is scratch. Allocates
+/// nothing.
+pub(super) fn write_quadratic_term(
+    post: &Posterior,
+    w: &[f64],
+    stride: usize,
+    n: usize,
+    w2: &mut [f64],
+    var: &mut [f64],
+) {
+    let (m, dx) = (post.m, post.dx);
+    match post.cov {
+        CovarianceStructure::Diagonal => {
             for (c2, wc) in w2[..m * n].chunks_exact_mut(m).zip(w.chunks(stride)) {
                 c2.iter_mut().zip(&wc[..m]).for_each(|(a, &b)| *a = b * b);
             }
@@ -146,7 +183,8 @@ pub(super) fn write_predictive_variance<H: Copy + Into<f64>>(
                 1.0,
             )
         }
-        (CovarianceStructure::Full, _) => {
+        CovarianceStructure::Full => {
+            let w_view = view(&w[..stride * n], stride, n).subrows(0, m);
             for dd in 0..dx {
                 let ld = &post.q_cov[dd * m * m..(dd + 1) * m * m];
                 gemm(
@@ -163,6 +201,21 @@ pub(super) fn write_predictive_variance<H: Copy + Into<f64>>(
             }
         }
     }
+}
+
+/// Adds `k** − w_nᵀh_n` to the quadratic terms in `var` (see [`write_predictive_variance`];
+/// `w` in `f64` or `f32`, the sums in `f64`). With `quad`, first writes the quadratic term
+/// less `w_nᵀh_n` (`σ²_d(n) − k**`) there (`D_x × N`). Allocates nothing.
+pub(super) fn add_base_variance<W: Copy + Into<f64>, H: Copy + Into<f64>>(
+    post: &Posterior,
+    w: &[W],
+    stride: usize,
+    k: Option<&[H]>,
+    n: usize,
+    var: &mut [f64],
+    mut quad: Option<&mut [f64]>,
+) {
+    let (m, dx) = (post.m, post.dx);
     for (j, v) in var[..dx * n].chunks_exact_mut(dx).enumerate() {
         let wc = &w[j * stride..j * stride + m];
         let wh = match k {

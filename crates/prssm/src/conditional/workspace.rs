@@ -3,38 +3,74 @@
 
 use faer::Accum;
 
-use super::predictive::write_predictive_variance;
+use faer::MatRef;
+
+use super::predictive::{
+    add_base_variance, uses_f32_quadratic_term, write_quadratic_term, write_quadratic_term_f32,
+};
 use super::{Posterior, forward_product, forward_product_f32};
 use crate::kernel;
 use crate::linalg::{dot, f32_operand, gemm, round_into, view, view_mut, widen_into};
 use crate::params::CovarianceStructure;
 use crate::precision::Precision;
 
-/// Per-step values kept for the reverse mode: the scaled inputs `X̃` (`D × N`),
-/// `σ_f² g'` (`M × N`), `[W; μ]` (`(M + D_x) × N`) and `σ² − σ_f²` (`D_x × N`), stored in one
-/// slice of [`tape_len`] values.
+/// Per-step values kept for the reverse mode, in one slice of [`tape_len`] `f64` slots: the
+/// scaled inputs `X̃` (`D × N`) and `σ² − σ_f²` (`D_x × N`) in `f64`, then the kernel's
+/// derivative and `[W; μ]` (`(M + D_x) × N`) in the precision that formed them.
 struct Tape<'a> {
     xs: &'a mut [f64],
-    kd: &'a mut [f64],
-    wm: &'a mut [f64],
     quad: &'a mut [f64],
+    values: TapeValues<'a>,
 }
 
-/// Values per step stored for the reverse mode of a batch of `capacity` points.
+enum TapeValues<'a> {
+    /// `σ_f² g'` (`M × N`) and `[W; μ]`.
+    F64 {
+        kd: &'a mut [f64],
+        wm: &'a mut [f64],
+    },
+    /// Mixed precision: `σ_f² eˣ` (`M × N`, with `σ_f² g' = c' σ_f² eˣ`,
+    /// [`kernel::shape_slope`]) and `[W; μ]` as the `f32` shape and product gave them. The
+    /// reverse mode reads their exact widenings, at half the memory traffic of `f64` copies.
+    F32 {
+        scaled_exp: &'a mut [f32],
+        wm: &'a mut [f32],
+    },
+}
+
+/// `f64` slots per step of the tape of a batch of `capacity` points.
 pub fn tape_len(post: &Posterior, capacity: usize) -> usize {
-    (post.d + 2 * post.m + 2 * post.dx) * capacity
+    let (f64_rows, value_rows) = (post.d + post.dx, 2 * post.m + post.dx);
+    match post.precision() {
+        Precision::F64 => (f64_rows + value_rows) * capacity,
+        Precision::Mixed => f64_rows * capacity + (value_rows * capacity).div_ceil(2),
+    }
 }
 
 fn split_tape<'a>(post: &Posterior, cap: usize, n: usize, tape: &'a mut [f64]) -> Tape<'a> {
     let (d, m, dx, r) = (post.d, post.m, post.dx, post.m + post.dx);
     let (xs, rest) = tape.split_at_mut(d * cap);
-    let (kd, rest) = rest.split_at_mut(m * cap);
-    let (wm, quad) = rest.split_at_mut(r * cap);
+    let (quad, rest) = rest.split_at_mut(dx * cap);
+    let values = match post.precision() {
+        Precision::F64 => {
+            let (kd, wm) = rest.split_at_mut(m * cap);
+            TapeValues::F64 {
+                kd: &mut kd[..m * n],
+                wm: &mut wm[..r * n],
+            }
+        }
+        Precision::Mixed => {
+            let (e, wm) = bytemuck::cast_slice_mut::<f64, f32>(rest).split_at_mut(m * cap);
+            TapeValues::F32 {
+                scaled_exp: &mut e[..m * n],
+                wm: &mut wm[..r * n],
+            }
+        }
+    };
     Tape {
         xs: &mut xs[..d * n],
-        kd: &mut kd[..m * n],
-        wm: &mut wm[..r * n],
         quad: &mut quad[..dx * n],
+        values,
     }
 }
 
@@ -67,10 +103,10 @@ pub struct ConditionalWorkspace {
 /// The `f32` side of the three large products of a step ([`crate::precision`]).
 #[derive(Debug, Clone)]
 struct MixedBuffers {
-    /// `K` (`M × N`).
+    /// `K` (`M × N`); in the reverse pass, the operands `W⊙W`.
     k: Vec<f32>,
-    /// `[W; μ]` (`(M + D_x) × N`).
-    wm: Vec<f32>,
+    /// `W` as a product operand (`M × N`, reverse pass).
+    w: Vec<f32>,
     /// `[P; μ̄]`, then `[A; μ̄]` (`(M + D_x) × N`).
     wbar: Vec<f32>,
     /// `Y` (`M × N`); in the forward pass, the scratch of `W⊙W`.
@@ -88,7 +124,7 @@ impl MixedBuffers {
         let r = m + dx;
         Self {
             k: vec![0.0; m * n],
-            wm: vec![0.0; r * n],
+            w: vec![0.0; m * n],
             wbar: vec![0.0; r * n],
             y: vec![0.0; m * n],
             gbar: vec![0.0; r * m],
@@ -210,29 +246,35 @@ impl ConditionalWorkspace {
         kernel::scale_points(&self.input[..d * n], &post.inv_len, t.xs);
         let points = post.grouped(t.xs, self.input_group);
         let r = m + dx;
-        let (w2, var) = (&mut self.w2, &mut self.var);
-        match self.mixed.as_mut() {
-            None => {
-                kernel::cross_cov_grouped(points, k, t.kd, &mut self.rowsum);
-                forward_product(post, k, n, t.wm);
+        let var = &mut self.var[..dx * n];
+        match (self.mixed.as_mut(), t.values) {
+            (None, TapeValues::F64 { kd, wm }) => {
+                kernel::cross_cov_grouped(points, k, kd, &mut self.rowsum);
+                forward_product(post, k, n, wm);
+                write_quadratic_term(post, wm, r, n, &mut self.w2, var);
                 let h = (!post.whitened).then_some(&*k);
-                write_predictive_variance(post, t.wm, r, h, n, w2, var, Some(t.quad), None);
+                add_base_variance(post, wm, r, h, n, var, Some(t.quad));
+                copy_means(wm, m, dx, &mut self.mean[..dx * n]);
             }
-            Some(mx) => {
+            (Some(mx), TapeValues::F32 { scaled_exp, wm }) => {
                 // `k` holds `τ`; `K` exists only in `f32`. `mx.y` is scratch until the reverse.
-                let kd = Some(&mut *t.kd);
-                kernel::cross_cov_grouped_f32(points, k, &mut mx.k, kd, &mut self.rowsum);
-                forward_product_f32(post, &mx.k, n, t.wm, &mut mx.wm);
+                let e = Some(&mut *scaled_exp);
+                kernel::cross_cov_grouped_f32(points, k, &mut mx.k, e, &mut self.rowsum);
+                forward_product_f32(post, &mx.k, n, wm);
+                if uses_f32_quadratic_term(post) {
+                    write_quadratic_term_f32(post, wm, r, n, &mut mx.y, &mut mx.var, var);
+                } else {
+                    // Full `S`: its `f64` products read `W` widened (`kbar` is free until the
+                    // reverse pass).
+                    let w = &mut self.kbar[..m * n];
+                    widen_rows(wm, r, m, w);
+                    write_quadratic_term(post, w, m, n, &mut self.w2, var);
+                }
                 let h = (!post.whitened).then_some(&mx.k[..m * n]);
-                let mixed = Some((&mut mx.y[..], &mut mx.var[..]));
-                write_predictive_variance(post, t.wm, r, h, n, w2, var, Some(t.quad), mixed);
+                add_base_variance(post, wm, r, h, n, var, Some(t.quad));
+                copy_means(wm, m, dx, &mut self.mean[..dx * n]);
             }
-        }
-        for (mean, col) in self.mean[..dx * n]
-            .chunks_exact_mut(dx)
-            .zip(t.wm.chunks_exact(r))
-        {
-            mean.copy_from_slice(&col[m..]);
+            _ => unreachable!("the tape and the workspace follow the posterior's precision"),
         }
     }
 
@@ -270,153 +312,154 @@ impl ConditionalWorkspace {
         let (m, dx) = (post.m, post.dx);
         let r = m + dx;
         let t = split_tape(post, self.cap, n, tape);
-        // `wm` holds `[W; μ]` (column stride `r`); `self.wbar` becomes `[P; μ̄]`, then `[A; μ̄]`.
-        let wm = &*t.wm;
-        let w_view = view(wm, r, n).subrows(0, m);
-        let wbar = &mut self.wbar[..r * n];
-        for (col, mb) in wbar.chunks_exact_mut(r).zip(mean_bar.chunks_exact(dx)) {
-            col[m..].copy_from_slice(mb);
-        }
+        let (mean_bar, var_bar) = (&mean_bar[..dx * n], &var_bar[..dx * n]);
         // β̄ = Σ_d σ̄²_d, the adjoint of the prior term σ_f² − Σ H⊙W.
-        for (j, vb) in var_bar[..dx * n].chunks_exact(dx).enumerate() {
+        for (j, vb) in var_bar.chunks_exact(dx).enumerate() {
             let bb: f64 = vb.iter().sum();
             self.base_bar[j] = bb;
             grads.variance += bb;
         }
+        let base_bar = &self.base_bar[..n];
         let kbar = &mut self.kbar[..m * n];
+        let wbar = &mut self.wbar[..r * n];
         let whitened = post.whitened;
-        match (post.cov, self.mixed.as_mut()) {
-            (CovarianceStructure::Diagonal, Some(mx)) => {
-                // As below, the three D_x-row products in f32 (S, σ̄², W⊙W ≥ 0 or of one sign).
-                round_into(&var_bar[..dx * n], &mut mx.var);
-                gemm(
-                    view_mut(&mut mx.y, m, n),
-                    Accum::Replace,
-                    view(&post.q_cov32, dx, m).transpose(),
-                    view(&mx.var, dx, n),
-                    1.0,
-                );
-                let cols = mx.k[..m * n]
-                    .chunks_exact_mut(m)
-                    .zip(wbar.chunks_exact_mut(r))
-                    .zip(mx.y.chunks_exact(m))
-                    .zip(wm.chunks_exact(r))
-                    .zip(&self.base_bar[..n]);
-                for ((((w2, pc), vc), wc), &bb) in cols {
-                    let (pc, wc) = (&mut pc[..m], &wc[..m]);
-                    let s = -2.0 * bb;
-                    for (((w2, p), &v), &wv) in w2.iter_mut().zip(pc.iter_mut()).zip(vc).zip(wc) {
-                        *w2 = f32_operand(wv * wv);
-                        *p = 2.0 * wv * f64::from(v);
-                        if whitened {
-                            *p += s * wv;
+        // `kbar` becomes K̄, then C = K̄ ⊙ σ_f² g' (the adjoint of τ).
+        let euler = match (self.mixed.as_mut(), t.values) {
+            (None, TapeValues::F64 { kd, wm }) => {
+                // `wbar` becomes [P; μ̄], then [A; μ̄].
+                copy_mean_adjoint(mean_bar, m, dx, wbar);
+                match post.cov {
+                    CovarianceStructure::Diagonal => {
+                        // V = Sᵀσ̄², then one pass: W⊙W and P = 2 W⊙V (whitened: − 2β̄W).
+                        gemm(
+                            view_mut(kbar, m, n),
+                            Accum::Replace,
+                            view(&post.q_cov, dx, m).transpose(),
+                            view(var_bar, dx, n),
+                            1.0,
+                        );
+                        let cols = self.w2[..m * n]
+                            .chunks_exact_mut(m)
+                            .zip(wbar.chunks_exact_mut(r))
+                            .zip(kbar.chunks_exact(m))
+                            .zip(wm.chunks_exact(r))
+                            .zip(base_bar);
+                        for ((((w2, pc), vc), wc), &bb) in cols {
+                            let (pc, wc) = (&mut pc[..m], &wc[..m]);
+                            let s = -2.0 * bb;
+                            let terms = w2.iter_mut().zip(pc.iter_mut()).zip(vc).zip(wc);
+                            for (((w2, p), &v), &wv) in terms {
+                                *w2 = wv * wv;
+                                *p = 2.0 * wv * v;
+                                if whitened {
+                                    *p += s * wv;
+                                }
+                            }
                         }
+                        gemm(
+                            view_mut(&mut grads.q_cov, dx, m),
+                            Accum::Add,
+                            view(var_bar, dx, n),
+                            view(&self.w2, m, n).transpose(),
+                            1.0,
+                        );
+                    }
+                    CovarianceStructure::Full => {
+                        let w = view(wm, r, n).subrows(0, m);
+                        full_cov_adjoint(post, w, var_bar, base_bar, wbar, &mut self.w2, grads);
                     }
                 }
-                gemm(
-                    view_mut(&mut mx.q_cov_bar, dx, m),
-                    Accum::Replace,
-                    view(&mx.var, dx, n),
-                    view(&mx.k, m, n).transpose(),
-                    1.0,
-                );
-                widen_into(&mx.q_cov_bar, &mut grads.q_cov, Accum::Add);
-            }
-            (CovarianceStructure::Diagonal, None) => {
-                // `V = Sᵀσ̄²`, then one pass: `W⊙W` and `P = 2 W⊙V` (whitened: `− 2β̄W`).
+                // Y = [G; mᵀG]ᵀ [P; μ̄]; then A (into the top rows of `wbar`) and K̄.
                 gemm(
                     view_mut(kbar, m, n),
                     Accum::Replace,
-                    view(&post.q_cov, dx, m).transpose(),
-                    view(var_bar, dx, n),
+                    post.g_mean().transpose(),
+                    view(wbar, r, n),
                     1.0,
                 );
-                let cols = self.w2[..m * n]
-                    .chunks_exact_mut(m)
-                    .zip(wbar.chunks_exact_mut(r))
-                    .zip(kbar.chunks_exact(m))
+                let cols = wbar
+                    .chunks_exact_mut(r)
+                    .zip(kbar.chunks_exact_mut(m))
                     .zip(wm.chunks_exact(r))
-                    .zip(&self.base_bar[..n]);
-                for ((((w2, pc), vc), wc), &bb) in cols {
-                    let (pc, wc) = (&mut pc[..m], &wc[..m]);
-                    let s = -2.0 * bb;
-                    for (((w2, p), &v), &wv) in w2.iter_mut().zip(pc.iter_mut()).zip(vc).zip(wc) {
-                        *w2 = wv * wv;
-                        *p = 2.0 * wv * v;
-                        if whitened {
-                            *p += s * wv;
+                    .zip(base_bar);
+                for (((ac, kc), wc), &bb) in cols {
+                    let (ac, wc) = (&mut ac[..m], &wc[..m]);
+                    if whitened {
+                        ac.copy_from_slice(kc);
+                    } else {
+                        for ((a, kb), &wv) in ac.iter_mut().zip(kc.iter_mut()).zip(wc) {
+                            *a = *kb - bb * wv;
+                            *kb = *a - bb * wv;
                         }
                     }
                 }
+                // [B; m̄ᵀ] += [A; μ̄] Wᵀ.
                 gemm(
-                    view_mut(&mut grads.q_cov, dx, m),
+                    view_mut(&mut grads.gbar, r, m),
                     Accum::Add,
-                    view(var_bar, dx, n),
-                    view(&self.w2, m, n).transpose(),
+                    view(wbar, r, n),
+                    view(wm, r, n).subrows(0, m).transpose(),
                     1.0,
                 );
+                kbar.iter_mut().zip(&*kd).for_each(|(c, &g)| *c *= g);
+                euler_sum(mean_bar, var_bar, wm, m, dx, t.quad)
             }
-            (CovarianceStructure::Full, _) => {
-                for col in wbar.chunks_exact_mut(r) {
-                    col[..m].fill(0.0);
-                }
-                for dd in 0..dx {
-                    let ld = &post.q_cov[dd * m * m..(dd + 1) * m * m];
-                    gemm(
-                        view_mut(&mut self.w2, m, n),
-                        Accum::Replace,
-                        view(ld, m, m).transpose(),
-                        w_view,
-                        1.0,
-                    );
-                    for j in 0..n {
-                        let s = 2.0 * var_bar[j * dx + dd];
-                        for v in &mut self.w2[j * m..(j + 1) * m] {
-                            *v *= s;
+            (Some(mx), TapeValues::F32 { scaled_exp, wm }) => {
+                // `mx.wbar` becomes the operands [P; μ̄], then [A; μ̄].
+                match post.cov {
+                    CovarianceStructure::Diagonal => {
+                        // As above, the three D_x-row products in f32 (S, σ̄², W⊙W ≥ 0 or of
+                        // one sign), and P and W⊙W rounded as they are formed.
+                        round_into(var_bar, &mut mx.var);
+                        gemm(
+                            view_mut(&mut mx.y, m, n),
+                            Accum::Replace,
+                            view(&post.q_cov32, dx, m).transpose(),
+                            view(&mx.var, dx, n),
+                            1.0,
+                        );
+                        let cols = mx.k[..m * n]
+                            .chunks_exact_mut(m)
+                            .zip(mx.wbar.chunks_exact_mut(r))
+                            .zip(mx.y.chunks_exact(m))
+                            .zip(wm.chunks_exact(r))
+                            .zip(mean_bar.chunks_exact(dx))
+                            .zip(base_bar);
+                        for (((((w2, pc), vc), wc), mb), &bb) in cols {
+                            let (pc, mc) = pc.split_at_mut(m);
+                            round_into(mb, mc);
+                            let s = -2.0 * bb;
+                            let terms = w2.iter_mut().zip(pc).zip(vc).zip(&wc[..m]);
+                            for (((w2, p), &v), &w) in terms {
+                                let wv = f64::from(w);
+                                *w2 = f32_operand(wv * wv);
+                                let mut pv = 2.0 * wv * f64::from(v);
+                                if whitened {
+                                    pv += s * wv;
+                                }
+                                *p = f32_operand(pv);
+                            }
                         }
+                        gemm(
+                            view_mut(&mut mx.q_cov_bar, dx, m),
+                            Accum::Replace,
+                            view(&mx.var, dx, n),
+                            view(&mx.k, m, n).transpose(),
+                            1.0,
+                        );
+                        widen_into(&mx.q_cov_bar, &mut grads.q_cov, Accum::Add);
                     }
-                    gemm(
-                        view_mut(wbar, r, n).subrows_mut(0, m),
-                        Accum::Add,
-                        view(ld, m, m),
-                        view(&self.w2, m, n),
-                        1.0,
-                    );
-                    let gl = &mut grads.q_cov[dd * m * m..(dd + 1) * m * m];
-                    gemm(
-                        view_mut(gl, m, m),
-                        Accum::Add,
-                        w_view,
-                        view(&self.w2, m, n).transpose(),
-                        1.0,
-                    );
-                }
-                if whitened {
-                    for ((pc, wc), &bb) in wbar
-                        .chunks_exact_mut(r)
-                        .zip(wm.chunks_exact(r))
-                        .zip(&self.base_bar[..n])
-                    {
-                        let s = -2.0 * bb;
-                        pc[..m]
-                            .iter_mut()
-                            .zip(&wc[..m])
-                            .for_each(|(p, &wv)| *p += s * wv);
+                    CovarianceStructure::Full => {
+                        // Its `f64` products read `W` widened (`k` is free in the reverse pass).
+                        let w = &mut self.k[..m * n];
+                        widen_rows(wm, r, m, w);
+                        copy_mean_adjoint(mean_bar, m, dx, wbar);
+                        let w = view(w, m, n);
+                        full_cov_adjoint(post, w, var_bar, base_bar, wbar, &mut self.w2, grads);
+                        round_into(wbar, &mut mx.wbar);
                     }
                 }
-            }
-        }
-        // Y = [G; mᵀG]ᵀ [P; μ̄]; then A (into the top rows of `wbar`) and K̄ (into `kbar`).
-        match self.mixed.as_mut() {
-            None => gemm(
-                view_mut(kbar, m, n),
-                Accum::Replace,
-                post.g_mean().transpose(),
-                view(wbar, r, n),
-                1.0,
-            ),
-            Some(mx) => {
-                round_into(wbar, &mut mx.wbar);
+                // Y in f32; then one pass: A and W as operands, and C = K̄ ⊙ σ_f² g'.
                 gemm(
                     view_mut(&mut mx.y, m, n),
                     Accum::Replace,
@@ -424,60 +467,45 @@ impl ConditionalWorkspace {
                     view(&mx.wbar, r, n),
                     1.0,
                 );
-                widen_into(&mx.y[..m * n], kbar, Accum::Replace);
-            }
-        }
-        let cols = wbar
-            .chunks_exact_mut(r)
-            .zip(kbar.chunks_exact_mut(m))
-            .zip(wm.chunks_exact(r))
-            .zip(&self.base_bar[..n]);
-        for (((ac, kc), wc), &bb) in cols {
-            let (ac, wc) = (&mut ac[..m], &wc[..m]);
-            if whitened {
-                ac.copy_from_slice(kc);
-            } else {
-                for ((a, kb), &wv) in ac.iter_mut().zip(kc.iter_mut()).zip(wc) {
-                    *a = *kb - bb * wv;
-                    *kb = *a - bb * wv;
+                let slope = kernel::shape_slope(post.kind);
+                let cols = mx
+                    .wbar
+                    .chunks_exact_mut(r)
+                    .zip(mx.w.chunks_exact_mut(m))
+                    .zip(kbar.chunks_exact_mut(m))
+                    .zip(mx.y.chunks_exact(m))
+                    .zip(wm.chunks_exact(r))
+                    .zip(scaled_exp.chunks_exact(m))
+                    .zip(base_bar);
+                for ((((((ac, wo), cc), yc), wc), ec), &bb) in cols {
+                    let terms = ac.iter_mut().zip(wo).zip(cc).zip(yc).zip(wc).zip(ec);
+                    for (((((a, wo), c), &y), &w), &e) in terms {
+                        let (wv, kb) = (f64::from(w), f64::from(y));
+                        let (av, kb) = if whitened {
+                            (kb, kb)
+                        } else {
+                            let av = kb - bb * wv;
+                            (av, av - bb * wv)
+                        };
+                        *a = f32_operand(av);
+                        *wo = f32_operand(wv);
+                        *c = kb * (slope * f64::from(e));
+                    }
                 }
-            }
-        }
-        // [B; m̄ᵀ] += [A; μ̄] Wᵀ.
-        match self.mixed.as_mut() {
-            None => gemm(
-                view_mut(&mut grads.gbar, r, m),
-                Accum::Add,
-                view(wbar, r, n),
-                w_view.transpose(),
-                1.0,
-            ),
-            Some(mx) => {
-                round_into(wbar, &mut mx.wbar);
-                round_into(wm, &mut mx.wm);
                 gemm(
                     view_mut(&mut mx.gbar, r, m),
                     Accum::Replace,
                     view(&mx.wbar, r, n),
-                    view(&mx.wm, r, n).subrows(0, m).transpose(),
+                    view(&mx.w, m, n).transpose(),
                     1.0,
                 );
                 widen_into(&mx.gbar, &mut grads.gbar, Accum::Add);
+                euler_sum(mean_bar, var_bar, wm, m, dx, t.quad)
             }
-        }
-        // ∂/∂σ_f² through K = σ_f² g: Σ K̄⊙K / σ_f², with Σ K̄⊙K = Σ μ̄⊙μ + 2 Σ σ̄²⊙(σ² − σ_f²).
-        let mut euler = 0.0;
-        for (((mb, col), vb), q) in mean_bar
-            .chunks_exact(dx)
-            .zip(wm.chunks_exact(r))
-            .zip(var_bar.chunks_exact(dx))
-            .zip(t.quad.chunks_exact(dx))
-        {
-            euler += dot(mb, &col[m..]) + 2.0 * dot(vb, q);
-        }
+            _ => unreachable!("the tape and the workspace follow the posterior's precision"),
+        };
+        // ∂/∂σ_f² through K = σ_f² g: Σ K̄⊙K / σ_f².
         grads.variance += euler / post.variance;
-        // C = K̄ ⊙ σ_f² g'.
-        kbar.iter_mut().zip(&*t.kd).for_each(|(c, &g)| *c *= g);
         kernel::cross_cov_backward(
             kbar,
             &post.zt,
@@ -491,5 +519,110 @@ impl ConditionalWorkspace {
             &mut self.zc[..post.d * n],
             &mut self.rowsum,
         );
+    }
+}
+
+/// The means `μ` (the bottom `D_x` rows of `[W; μ]`, column stride `M + D_x`) into `mean`
+/// (`D_x × N`).
+fn copy_means<W: Copy + Into<f64>>(wm: &[W], m: usize, dx: usize, mean: &mut [f64]) {
+    for (mean, col) in mean.chunks_exact_mut(dx).zip(wm.chunks_exact(m + dx)) {
+        mean.iter_mut()
+            .zip(&col[m..])
+            .for_each(|(a, &b)| *a = b.into());
+    }
+}
+
+/// The first `rows` rows of `src` (column stride `stride`) widened into `dst`
+/// (column-major `rows × N`).
+fn widen_rows(src: &[f32], stride: usize, rows: usize, dst: &mut [f64]) {
+    for (d, s) in dst.chunks_exact_mut(rows).zip(src.chunks_exact(stride)) {
+        widen_into(&s[..rows], d, Accum::Replace);
+    }
+}
+
+/// `μ̄` (`D_x × N`) into the bottom rows of `wbar` (`(M + D_x) × N`).
+fn copy_mean_adjoint(mean_bar: &[f64], m: usize, dx: usize, wbar: &mut [f64]) {
+    for (col, mb) in wbar.chunks_exact_mut(m + dx).zip(mean_bar.chunks_exact(dx)) {
+        col[m..].copy_from_slice(mb);
+    }
+}
+
+/// `Σ K̄⊙K = Σ μ̄⊙μ + 2 Σ σ̄²⊙(σ² − σ_f²)` (`μ` linear, `σ² − σ_f²` quadratic in `K`), with
+/// `μ` the bottom rows of `[W; μ]` and `quad = σ² − σ_f²` from the tape.
+fn euler_sum<W: Copy + Into<f64>>(
+    mean_bar: &[f64],
+    var_bar: &[f64],
+    wm: &[W],
+    m: usize,
+    dx: usize,
+    quad: &[f64],
+) -> f64 {
+    let mut euler = 0.0;
+    for (((mb, col), vb), q) in mean_bar
+        .chunks_exact(dx)
+        .zip(wm.chunks_exact(m + dx))
+        .zip(var_bar.chunks_exact(dx))
+        .zip(quad.chunks_exact(dx))
+    {
+        euler += dot(mb, &col[m..]) + 2.0 * dot(vb, q);
+    }
+    euler
+}
+
+/// Full `S = L_d L_dᵀ`: `P = Σ_d 2σ̄²_d L_d L_dᵀ W` (whitened: `− 2β̄W`) into the top rows
+/// of `wbar` and `∂/∂L_d += W (2σ̄²_d ⊙ L_dᵀW)ᵀ`, from `W` (`M × N`); `w2` (`M × N`) is
+/// scratch.
+fn full_cov_adjoint(
+    post: &Posterior,
+    w: MatRef<'_, f64>,
+    var_bar: &[f64],
+    base_bar: &[f64],
+    wbar: &mut [f64],
+    w2: &mut [f64],
+    grads: &mut ConditionalGrads,
+) {
+    let (m, dx, n) = (post.m, post.dx, w.ncols());
+    let r = m + dx;
+    for col in wbar.chunks_exact_mut(r) {
+        col[..m].fill(0.0);
+    }
+    for dd in 0..dx {
+        let ld = &post.q_cov[dd * m * m..(dd + 1) * m * m];
+        gemm(
+            view_mut(w2, m, n),
+            Accum::Replace,
+            view(ld, m, m).transpose(),
+            w,
+            1.0,
+        );
+        for j in 0..n {
+            let s = 2.0 * var_bar[j * dx + dd];
+            for v in &mut w2[j * m..(j + 1) * m] {
+                *v *= s;
+            }
+        }
+        gemm(
+            view_mut(wbar, r, n).subrows_mut(0, m),
+            Accum::Add,
+            view(ld, m, m),
+            view(w2, m, n),
+            1.0,
+        );
+        let gl = &mut grads.q_cov[dd * m * m..(dd + 1) * m * m];
+        gemm(
+            view_mut(gl, m, m),
+            Accum::Add,
+            w,
+            view(w2, m, n).transpose(),
+            1.0,
+        );
+    }
+    if post.whitened {
+        for (j, (pc, &bb)) in wbar.chunks_exact_mut(r).zip(base_bar).enumerate() {
+            let s = -2.0 * bb;
+            for (i, p) in pc[..m].iter_mut().enumerate() {
+                *p += s * w[(i, j)];
+            }
+        }
     }
 }

@@ -680,25 +680,29 @@ mod tests {
         opts.particles = 4;
         opts.windows_per_task = 2;
         let elbo = Elbo::new(config, data, opts).unwrap();
-        let step_bytes = 8 * conditional::tape_len(
-            &Posterior::new(
-                elbo.config(),
-                &Params::from_unconstrained(elbo.config(), &theta).unwrap(),
-            )
-            .unwrap(),
-            8,
-        );
         let run = |e: &Elbo| {
             let mut g = vec![0.0; theta.len()];
             let loss = e.loss_and_grad(&theta, &batch, 11, &mut g).unwrap();
             (loss, g)
         };
-        let full = run(&elbo);
-        assert!(full.1.iter().any(|&v| v != 0.0));
-        for steps in [1, 3, 5] {
-            let e = elbo.clone().with_tape_budget(steps * step_bytes);
-            assert_eq!(run(&e), full, "{steps} steps per segment");
+        // Both tape layouts (mixed precision keeps its `f32` values in `f32`).
+        for precision in [Precision::Mixed, Precision::F64] {
+            let mut post = Posterior::new(
+                elbo.config(),
+                &Params::from_unconstrained(elbo.config(), &theta).unwrap(),
+            )
+            .unwrap();
+            post.set_precision(precision);
+            let step_bytes = 8 * conditional::tape_len(&post, 8);
+            let elbo = elbo.clone().with_precision(precision);
+            let full = run(&elbo);
+            assert!(full.1.iter().any(|&v| v != 0.0));
+            for steps in [1, 3, 5] {
+                let e = elbo.clone().with_tape_budget(steps * step_bytes);
+                assert_eq!(run(&e), full, "{precision:?}: {steps} steps per segment");
+            }
         }
+        let full = run(&elbo);
         // A repeated evaluation reuses the pooled buffers.
         assert_eq!(run(&elbo), full);
         // Other task sizes draw the same numbers (per window) and sum in another order: the
