@@ -440,14 +440,12 @@ impl ConditionalWorkspace {
                                 *p = f32_operand(pv);
                             }
                         }
-                        gemm(
-                            view_mut(&mut mx.q_cov_bar, dx, m),
-                            Accum::Replace,
+                        add_product_f32(
+                            &mut grads.q_cov,
+                            &mut mx.q_cov_bar,
                             view(&mx.var, dx, n),
                             view(&mx.k, m, n).transpose(),
-                            1.0,
                         );
-                        widen_into(&mx.q_cov_bar, &mut grads.q_cov, Accum::Add);
                     }
                     CovarianceStructure::Full => {
                         // Its `f64` products read `W` widened (`k` is free in the reverse pass).
@@ -492,14 +490,12 @@ impl ConditionalWorkspace {
                         *c = kb * (slope * f64::from(e));
                     }
                 }
-                gemm(
-                    view_mut(&mut mx.gbar, r, m),
-                    Accum::Replace,
+                add_product_f32(
+                    &mut grads.gbar,
+                    &mut mx.gbar,
                     view(&mx.wbar, r, n),
                     view(&mx.w, m, n).transpose(),
-                    1.0,
                 );
-                widen_into(&mx.gbar, &mut grads.gbar, Accum::Add);
                 euler_sum(mean_bar, var_bar, wm, m, dx, t.quad)
             }
             _ => unreachable!("the tape and the workspace follow the posterior's precision"),
@@ -520,6 +516,15 @@ impl ConditionalWorkspace {
             &mut self.rowsum,
         );
     }
+}
+
+/// `sums += a b` (column-major, `a.nrows() × b.ncols()`): the product formed in `f32` into
+/// `product`, then widened and added to the `f64` sums.
+fn add_product_f32(sums: &mut [f64], product: &mut [f32], a: MatRef<'_, f32>, b: MatRef<'_, f32>) {
+    let len = a.nrows() * b.ncols();
+    let out = view_mut(&mut product[..len], a.nrows(), b.ncols());
+    gemm(out, Accum::Replace, a, b, 1.0);
+    widen_into(&product[..len], sums, Accum::Add);
 }
 
 /// The means `μ` (the bottom `D_x` rows of `[W; μ]`, column stride `M + D_x`) into `mean`
