@@ -15,10 +15,11 @@
 //! `f64`, then the shape (`√`, `exp`, `(1 + r)e⁻ʳ`) runs on `f32` lanes
 //! (`kernel::cross_cov_grouped_f32`, twice the lanes of `f64`), which moves `K` by at most
 //! `2·2⁻²³ σ_f²` (`kernel::tests::f32_shape_matches_the_f64_kernel`); the reverse pass reads
-//! `σ_f² g' = c′ σ_f² eˣ` and `W` widened from the `f32` values the tape keeps. The other operands are rounded to `f32` (`[G; mᵀG]` and `S` once
-//! per evaluation, the others per step), the products are formed in `f32`, and their results
-//! are widened back: most feed `f64` code, the parameter adjoints are added to their `f64` sums
-//! over steps. Everything else stays `f64`: `τ`, the factorization of `K_mm`, `G`, the
+//! `σ_f² g' = c′ σ_f² eˣ` and `W` widened from the `f32` values the tape keeps. The other
+//! operands are rounded to `f32` (`[G; mᵀG]` and `S` once per evaluation, the others per
+//! step), the products are formed in `f32`, and their results are widened back: most feed
+//! `f64` code, the parameter adjoints are added to their `f64` sums over steps.
+//! Everything else stays `f64`: `τ`, the factorization of `K_mm`, `G`, the
 //! cancellation `σ_f² − Σ H⊙W` of the predictive variance (summed in `f64` from the `f32` `K`
 //! and the widened `W`), the KL, the likelihood, the draws, the kernel's reverse mode (whose
 //! expanded sums `Σ z̃c − x̃s` cancel) and every reduction. The variance's cancellation sees
