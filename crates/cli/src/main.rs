@@ -43,6 +43,9 @@ enum Command {
         #[command(subcommand)]
         command: cmd::qs::QsCommand,
     },
+    /// The rig as the judge: a dataset of the paper's trajectories against the published model's
+    /// prediction of the rig's loads; the mount angles that bring a wing closest to it.
+    Rig(cmd::rig::RigArgs),
     /// Evaluate a PR-SSM and an LRQSM on a dataset: metrics, authority, figures, report.
     Evaluate(cmd::evaluate::EvaluateArgs),
     /// PR-SSM sweeps: `run` one configuration (D_x or training-set size), `merge` results.
@@ -91,6 +94,7 @@ fn run(command: Command) -> anyhow::Result<()> {
         Command::Trajectories(args) => cmd::trajectories::run(args),
         Command::Simulate(args) => cmd::simulate::run(args),
         Command::Qs { command } => cmd::qs::run(command),
+        Command::Rig(args) => cmd::rig::run(args),
         Command::Evaluate(args) => cmd::evaluate::run(args),
         Command::Sweep { command } => cmd::sweep::run(command),
         Command::Demo(args) => cmd::demo::run(args),

@@ -217,12 +217,14 @@ fn simulate_takes_the_l2_wake_model_and_refuses_unknown_names() {
     }
 }
 
-/// `simulate` runs the vortex lattice by default and `--inflow` sets its wake's inflow (both
-/// recorded in the metadata; finite loads, changed by the inflow), and an unknown level is
-/// refused with the levels named.
+/// `simulate` runs the default wing (L0 with the rig's mount, docs/rig-agreement.md), `--fidelity
+/// l3` the vortex lattice and `--inflow` sets its wake's inflow (all recorded in the metadata;
+/// finite loads, changed by the inflow); `--wing-config` sets any field of the wing and refuses
+/// a misspelt one by name; an unknown level is refused with the levels named.
 #[test]
-fn simulate_runs_the_vortex_lattice() {
+fn simulate_runs_the_default_wing_and_the_vortex_lattice() {
     let dir = tempfile::tempdir().unwrap();
+    let default = dir.path().join("default.npz");
     let out = dir.path().join("l3.npz");
     let still = dir.path().join("still.npz");
     let run = |extra: &[&str], out: &Path| {
@@ -232,13 +234,62 @@ fn simulate_runs_the_vortex_lattice() {
         ok(&argv);
         Dataset::load(out).unwrap()
     };
-    // The default wing is L3; --inflow sets what carries its wake (momentum by default).
-    let ds = run(&[], &out);
+    let d = run(&[], &default);
+    assert_eq!(d.meta.settings["fidelity"], "l0");
+    assert_eq!(d.meta.settings["wing"]["mount"]["plate_pitch_deg"], 4.5);
+    let ds = run(&["--fidelity", "l3"], &out);
     let ds_still = run(&["--fidelity", "l3", "--inflow", "still"], &still);
     for (d, inflow) in [(&ds, "momentum"), (&ds_still, "still")] {
         assert_eq!(d.meta.settings["fidelity"], "l3");
         assert_eq!(d.meta.settings["wing"]["l3"]["inflow"], inflow);
     }
+    let config = dir.path().join("wing.json");
+    std::fs::write(
+        &config,
+        r#"{"fidelity": "l1", "mount": {"sensor_pitch_deg": -2.0}}"#,
+    )
+    .unwrap();
+    let configured = run(&["--wing-config", s(&config)], &dir.path().join("c.npz"));
+    assert_eq!(configured.meta.settings["fidelity"], "l1");
+    assert_eq!(
+        configured.meta.settings["wing"]["mount"]["sensor_pitch_deg"],
+        -2.0
+    );
+    assert_eq!(
+        configured.meta.settings["wing"]["mount"]["plate_pitch_deg"],
+        4.5
+    );
+    std::fs::write(&config, r#"{"mount": {"plate_pich_deg": 2.0}}"#).unwrap();
+    let bad = dir.path().join("bad.npz");
+    let o = flapssm(&[
+        "simulate",
+        "--source",
+        "paper",
+        "--n",
+        "2",
+        "--wing-config",
+        s(&config),
+        "--out",
+        s(&bad),
+    ]);
+    assert_fails(
+        &o,
+        &["mount.plate_pich_deg", "wing.json", "no such field"],
+        &bad,
+    );
+    std::fs::write(&config, r#"{"mount": {"plate_pitch_deg": 50.0}}"#).unwrap();
+    let o = flapssm(&[
+        "simulate",
+        "--source",
+        "paper",
+        "--n",
+        "2",
+        "--wing-config",
+        s(&config),
+        "--out",
+        s(&bad),
+    ]);
+    assert_fails(&o, &["mount.plate_pitch_deg", "45"], &bad);
     let outputs = |d: &Dataset| -> Vec<f64> {
         d.trajectories
             .iter()

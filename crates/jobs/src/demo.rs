@@ -41,6 +41,10 @@ use crate::models::prssm::PrssmLoadModel;
 use crate::models::{BASELINES, Baseline, LoadModel, baseline};
 use crate::paper_comparison::ComparisonRow;
 use crate::progress::Progress;
+use crate::rig::{
+    RIG_FILES, RigCheck, RigSettings, load_reference_model, rig_check, rig_reference,
+    write_rig_check,
+};
 use crate::simulate::{TrajectorySource, check_paper_count, paper_dataset, simulate};
 use crate::train::{TrainingOptions, TrainingPlan, train_prssm};
 use flapssm_analysis::stats::{Interval, median};
@@ -88,6 +92,11 @@ pub struct DemoConfig {
     pub baselines: Vec<String>,
     /// Evaluation.
     pub evaluation: EvalOptions,
+    /// The reference model of the rig check ([`crate::rig`]: the published `.npz` or a model
+    /// imported from it), run on the dataset when its trajectories are the paper's; its
+    /// section heads the report and `summary.json` holds its agreement.
+    #[serde(default)]
+    pub rig_reference: Option<PathBuf>,
 }
 
 impl DemoConfig {
@@ -129,6 +138,7 @@ impl DemoConfig {
                 seed,
                 ..EvalOptions::default()
             },
+            rig_reference: None,
         }
     }
 
@@ -158,6 +168,7 @@ impl DemoConfig {
                 seed,
                 ..EvalOptions::default()
             },
+            rig_reference: None,
         }
     }
 
@@ -175,6 +186,24 @@ impl DemoConfig {
         crate::resources::check_dataset("trajectories", t.n_trajectories, t.sampling.n_samples)?;
         if self.source == TrajectorySource::Paper {
             check_paper_count("trajectories", t.n_trajectories)?;
+        }
+        if let Some(path) = &self.rig_reference {
+            if self.source != TrajectorySource::Paper {
+                return Err(JobError::Setting {
+                    name: "reference".into(),
+                    value: path.display().to_string(),
+                    expected:
+                        "the rig check needs the paper's trajectories (--full or --source paper)"
+                            .into(),
+                });
+            }
+            if !path.is_file() {
+                return Err(JobError::Setting {
+                    name: "reference".into(),
+                    value: path.display().to_string(),
+                    expected: "an existing reference model file".into(),
+                });
+            }
         }
         if t.n_train == 0 || t.n_train >= t.n_trajectories {
             return Err(JobError::Setting {
@@ -277,6 +306,10 @@ pub struct DemoSummary {
     pub versions: Vec<(String, String)>,
     /// The evaluation report, relative to the demo folder.
     pub report: String,
+    /// The rig check of the dataset ([`DemoConfig::rig_reference`]; its lag statistics in
+    /// `rig/rig-check.json`).
+    #[serde(default)]
+    pub rig_agreement: Option<RigCheck>,
 }
 
 /// Test accuracy of a further baseline.
@@ -417,6 +450,34 @@ pub fn run_demo(
         },
     )?;
 
+    // 1b. The rig check, on the paper's trajectories with a reference.
+    let rig_dir = dir.join("rig");
+    let rig_json = rig_dir.join(RIG_FILES[0]);
+    let k_rig = cfg.rig_reference.as_ref().map(|path| {
+        serde_json::json!({
+            "upstream": k_sim,
+            "reference": path,
+            "reference_bytes": std::fs::metadata(path).map(|m| m.len()).ok(),
+            "settings": json(&RigSettings::default()),
+        })
+    });
+    let rig = match (&cfg.rig_reference, &k_rig) {
+        (Some(path), Some(key)) => Some(run.stage(
+            "rig",
+            key,
+            &[&rig_json],
+            || load_json::<RigCheck>(&rig_json),
+            |p| {
+                let model = load_reference_model(path)?;
+                let reference = rig_reference(&model, ds.len(), &RigSettings::default(), p)?;
+                let check = rig_check(&ds, &reference, true)?;
+                write_rig_check(&rig_dir, &check, &ds, &reference, "demo dataset")?;
+                Ok(check)
+            },
+        )?),
+        _ => None,
+    };
+
     // 2. LRQSM.
     let lq_path = dir.join("lrqsm.json");
     let k_lq = serde_json::json!({ "upstream": k_sim, "features": json(&cfg.lrqsm_features), "options": json(&cfg.lrqsm) });
@@ -522,6 +583,7 @@ pub fn run_demo(
     let k_ev = serde_json::json!({
         "lrqsm": k_lq, "prssm": k_pm, "baselines": json(&cfg.baselines),
         "evaluation": json(&cfg.evaluation), "metrics_version": METRICS_VERSION,
+        "rig": k_rig,
     });
     let timings_so_far: Vec<(String, String)> = run
         .timings
@@ -551,6 +613,13 @@ pub fn run_demo(
                 ),
                 headline: timings_so_far,
                 config: json(cfg),
+                extra_sections: rig
+                    .iter()
+                    .map(|c| {
+                        let figure = rig_dir.join(RIG_FILES[2]);
+                        c.report_section(figure.exists().then_some(figure))
+                    })
+                    .collect(),
             };
             let e = &cfg.evaluation;
             let prssm = PrssmLoadModel::new(&prssm, &ds, e.particles, e.seed)?;
@@ -573,7 +642,8 @@ pub fn run_demo(
         },
     )?;
 
-    let summary = summarize(cfg, &report, run.timings, t_all.elapsed().as_secs_f64());
+    let mut summary = summarize(cfg, &report, run.timings, t_all.elapsed().as_secs_f64());
+    summary.rig_agreement = rig.map(RigCheck::without_lags);
     save_json(&dir.join("summary.json"), &summary)?;
     Ok(summary)
 }
@@ -641,6 +711,7 @@ fn summarize(
         total_wall_s,
         versions: versions(),
         report: "eval/report.html".into(),
+        rig_agreement: None,
     }
 }
 

@@ -30,6 +30,17 @@ pub enum JobError {
         /// Cause.
         source: flapssm_prssm::ModelFileError,
     },
+    /// The published model's parameter file could not be imported.
+    #[error("published model {path}: {source}")]
+    PublishedModel {
+        /// The file.
+        path: PathBuf,
+        /// Cause.
+        source: flapssm_prssm::published::ImportError,
+    },
+    /// Trajectories could not be generated or read.
+    #[error("trajectories: {0}")]
+    Trajectories(#[from] flapssm_wing::trajectories::TrajectoryError),
     /// The LRQSM failed (fit, prediction or model file).
     #[error("LRQSM: {0}")]
     Qs(#[from] QsError),

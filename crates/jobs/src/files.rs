@@ -33,6 +33,14 @@ pub fn save_json<T: Serialize>(path: &Path, value: &T) -> Result<()> {
     write_json(path, value)
 }
 
+/// Writes `text`, atomically.
+///
+/// # Errors
+/// [`JobError::Io`] naming the file.
+pub fn save_text(path: &Path, text: &str) -> Result<()> {
+    write_text(path, text)
+}
+
 /// Reads a JSON file.
 ///
 /// # Errors
@@ -45,6 +53,85 @@ pub fn load_json<T: serde::de::DeserializeOwned>(path: &Path) -> Result<T> {
     serde_json::from_slice(&bytes).map_err(|source| JobError::Json {
         path: path.to_path_buf(),
         source,
+    })
+}
+
+/// Reads a configuration file (JSON) of the fields that differ from `T::default()`: the file is
+/// laid over the default, field by field at every depth (a missing field keeps the default's
+/// value, also inside a nested table), and any field the configuration does not have is
+/// refused (a misspelt `l3.lesp_critt` would otherwise be ignored without a word).
+///
+/// # Errors
+/// [`JobError::Io`] / [`JobError::Json`] naming the file; [`JobError::Setting`] naming the file
+/// and the unknown field's path.
+pub fn load_config<T>(path: &Path) -> Result<T>
+where
+    T: serde::de::DeserializeOwned + Serialize + Default,
+{
+    config_from_value(load_json(path)?, path)
+}
+
+/// A configuration from parsed JSON `given` (from `source`, a file or a language binding's
+/// name for it), laid over `T::default()` as [`load_config`] does.
+///
+/// # Errors
+/// [`JobError::Json`] for a value of the wrong type; [`JobError::Setting`] naming `source` and
+/// the unknown field's path.
+pub fn config_from_value<T>(given: serde_json::Value, source: &Path) -> Result<T>
+where
+    T: serde::de::DeserializeOwned + Serialize + Default,
+{
+    let json_error = |source_error| JobError::Json {
+        path: source.to_path_buf(),
+        source: source_error,
+    };
+    let mut merged = serde_json::to_value(T::default()).map_err(json_error)?;
+    lay_over(&mut merged, &given);
+    let config: T = serde_json::from_value(merged).map_err(json_error)?;
+    let known = serde_json::to_value(&config).map_err(json_error)?;
+    if let Some(field) = unknown_field(&given, &known, "") {
+        return Err(JobError::Setting {
+            name: field,
+            value: format!("(in {})", source.display()),
+            expected: "no such field".into(),
+        });
+    }
+    Ok(config)
+}
+
+/// Lays `given` over `base`: objects merge key by key, recursively; anything else replaces.
+fn lay_over(base: &mut serde_json::Value, given: &serde_json::Value) {
+    match (base, given) {
+        (serde_json::Value::Object(base), serde_json::Value::Object(given)) => {
+            for (key, value) in given {
+                match base.get_mut(key) {
+                    Some(slot) => lay_over(slot, value),
+                    None => {
+                        base.insert(key.clone(), value.clone());
+                    }
+                }
+            }
+        }
+        (base, given) => *base = given.clone(),
+    }
+}
+
+/// The first key path of `given` that `known` (the parsed value written back) lacks.
+fn unknown_field(given: &serde_json::Value, known: &serde_json::Value, at: &str) -> Option<String> {
+    let (serde_json::Value::Object(given), serde_json::Value::Object(known)) = (given, known)
+    else {
+        return None;
+    };
+    given.iter().find_map(|(key, value)| {
+        let path = if at.is_empty() {
+            key.clone()
+        } else {
+            format!("{at}.{key}")
+        };
+        match known.get(key) {
+            None => Some(path),
+            Some(k) => unknown_field(value, k, &path),
+        }
     })
 }
 

@@ -12,10 +12,12 @@
 //! | [`stream`] | real-time PR-SSM prediction, one sample at a time (CSV in, CSV out) |
 //! | [`models`] | the load models behind one trait (PR-SSM, LRQSM, ARX) |
 //! | [`evaluate`] | both models on a dataset: metrics, authority, figures, report |
+//! | [`rig`] | a dataset on the paper's trajectories against the published model's prediction of the rig's loads |
 //! | [`sweep`] | one-configuration PR-SSM sweep runs (D_x, training-set size) and their merge |
 //! | [`demo`] | the one-command demo: simulate, fit, train, evaluate (resumable) |
 //! | [`bench`](mod@bench) | the engine's speed in the paper's configuration beside the authors' code |
 //! | [`curve`] | learning curves with wall times, and the time-to-quality read from them |
+//! | [`wang2004`] | the published 2-D hovering experiment (Wang, Birch & Dickinson 2004) beside every fidelity |
 //! | [`sysid`] | Doerr et al. system-identification protocol (fit, open-loop test, RMSE/NLL) |
 //!
 //! Shared pieces: [`error`] (one error type naming the file, trajectory or stage), [`progress`]
@@ -36,6 +38,7 @@ pub mod paper_comparison;
 pub mod predict;
 pub mod progress;
 pub mod resources;
+pub mod rig;
 pub mod seed;
 pub mod simulate;
 pub mod stream;
@@ -45,6 +48,7 @@ pub mod sysid;
 mod test_data;
 pub mod threads;
 pub mod train;
+pub mod wang2004;
 
 pub use error::{JobError, Result};
 pub use progress::{NoProgress, Progress};

@@ -16,8 +16,8 @@ use flapssm_wing::vortex::{Inflow, WakeMotion};
 use crate::error::{JobError, Result};
 use crate::progress::Progress;
 
-/// Settings of [`simulate`]: a few choices over [`SimulationConfig::default`].
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// Settings of [`simulate`]: a few choices over a wing (by default [`VirtualWingConfig::default`]).
+#[derive(Debug, Clone, PartialEq)]
 pub struct SimulateSettings {
     /// Trajectories.
     pub n_trajectories: usize,
@@ -25,8 +25,11 @@ pub struct SimulateSettings {
     pub n_train: Option<usize>,
     /// Seed of the trajectories and the sensor.
     pub seed: u64,
-    /// Aerodynamic fidelity.
-    pub fidelity: Fidelity,
+    /// The wing the choices below apply to (`None`: [`VirtualWingConfig::default`]); a wing
+    /// file of `flapssm simulate --wing-config`.
+    pub wing: Option<VirtualWingConfig>,
+    /// Aerodynamic fidelity (`None`: the wing's).
+    pub fidelity: Option<Fidelity>,
     /// Without the sensor chain (no noise, drift, filtering).
     pub noise_free: bool,
     /// No stroke deviation (planar strokes).
@@ -40,13 +43,14 @@ pub struct SimulateSettings {
 }
 
 impl Default for SimulateSettings {
-    /// 548 trajectories (512 training), seed 0, the default fidelity, with the sensor.
+    /// 548 trajectories (512 training), seed 0, the default wing, with the sensor.
     fn default() -> Self {
         Self {
             n_trajectories: 548,
             n_train: None,
             seed: 0,
-            fidelity: VirtualWingConfig::default().fidelity,
+            wing: None,
+            fidelity: None,
             noise_free: false,
             flat: false,
             wake_motion: None,
@@ -88,22 +92,21 @@ impl SimulateSettings {
             trajectories.max_deviation_deg = 0.0;
         }
         crate::resources::check_dataset("n", n, trajectories.sampling.n_samples)?;
-        let mut wing = VirtualWingConfig {
-            fidelity: self.fidelity,
-            sensor: if self.noise_free {
-                SensorConfig::noise_free()
-            } else {
-                SensorConfig::default()
-            },
-            ..VirtualWingConfig::default()
-        };
+        let mut wing = self.wing.clone().unwrap_or_default();
+        if let Some(fidelity) = self.fidelity {
+            wing.fidelity = fidelity;
+        }
+        if self.noise_free {
+            wing.sensor = SensorConfig::noise_free();
+        }
+        let fidelity = wing.fidelity;
         let refuse = |name: &str, value: String, expected: &str| JobError::Setting {
             name: name.into(),
             value,
-            expected: format!("{expected} (the fidelity is {:?})", self.fidelity),
+            expected: format!("{expected} (the fidelity is {fidelity:?})"),
         };
         if let Some(motion) = self.wake_motion {
-            if self.fidelity != Fidelity::L2 {
+            if fidelity != Fidelity::L2 {
                 return Err(refuse(
                     "wake",
                     motion.to_string(),
@@ -113,7 +116,7 @@ impl SimulateSettings {
             wing.l2.ldvm.wake_motion = motion;
         }
         if let Some(inflow) = self.inflow {
-            match self.fidelity {
+            match fidelity {
                 Fidelity::L2 => wing.l2.inflow = inflow,
                 Fidelity::L3 => wing.l3.inflow = inflow,
                 Fidelity::L0 | Fidelity::L1 => {
@@ -315,7 +318,7 @@ mod tests {
     fn wake_and_inflow_reach_their_fidelity_or_are_refused() {
         let with = |fidelity, wake_motion, inflow| {
             SimulateSettings {
-                fidelity,
+                fidelity: Some(fidelity),
                 wake_motion,
                 inflow,
                 ..SimulateSettings::default()
@@ -372,7 +375,7 @@ mod tests {
         let settings = SimulateSettings {
             n_trajectories: 3,
             noise_free: true,
-            fidelity: flapssm_wing::virtual_wing::Fidelity::L0,
+            fidelity: Some(flapssm_wing::virtual_wing::Fidelity::L0),
             ..SimulateSettings::default()
         };
         let ds = simulate_paper(&settings, &NoProgress).unwrap();
@@ -387,14 +390,14 @@ mod tests {
             (
                 SimulateSettings {
                     n_trajectories: 549,
-                    ..settings
+                    ..settings.clone()
                 },
                 "setting n = 549",
             ),
             (
                 SimulateSettings {
                     flat: true,
-                    ..settings
+                    ..settings.clone()
                 },
                 "setting flat",
             ),

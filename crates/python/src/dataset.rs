@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use flapssm_jobs::simulate::SimulateSettings;
 use flapssm_wing::cycles::{U_REF_RADIUS_M, published_u_ref};
 use flapssm_wing::dataset::{Dataset as WingDataset, DatasetMeta, Trajectory, ValidDataset};
-use flapssm_wing::virtual_wing::Fidelity;
+use flapssm_wing::virtual_wing::{Fidelity, VirtualWingConfig};
 use numpy::{
     PyArray1, PyArray3, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray3, PyUntypedArrayMethods,
 };
@@ -213,27 +213,48 @@ fn as_rows<const K: usize>(flat: &[f64]) -> Vec<[f64; K]> {
         .collect()
 }
 
+/// The fidelity named (`None`: the wing's) and the wing given as JSON text (`None`: the
+/// default wing), checked as `flapssm simulate --wing-config` checks its file.
+fn wing_choices(
+    fidelity: Option<&str>,
+    wing_json: Option<&str>,
+) -> PyResult<(Option<Fidelity>, Option<VirtualWingConfig>)> {
+    let fidelity = fidelity
+        .map(|f| f.parse::<Fidelity>())
+        .transpose()
+        .map_err(|e| PyValueError::new_err(format!("fidelity: {e}")))?;
+    let wing = wing_json
+        .map(|text| {
+            let value: serde_json::Value = serde_json::from_str(text)
+                .map_err(|e| PyValueError::new_err(format!("wing: {e}")))?;
+            flapssm_jobs::files::config_from_value(value, std::path::Path::new("wing"))
+                .map_err(|e| job_error(e, None))
+        })
+        .transpose()?;
+    Ok((fidelity, wing))
+}
+
 /// Simulates the virtual wing on `n` generated trajectories (`flapssm simulate`).
 #[pyfunction]
-#[pyo3(signature = (n, seed, fidelity, n_train=None, noise_free=false, flat=false, progress=None))]
+#[pyo3(signature = (n, seed, fidelity=None, wing=None, n_train=None, noise_free=false, flat=false, progress=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn simulate(
     py: Python<'_>,
     n: usize,
     seed: u64,
-    fidelity: &str,
+    fidelity: Option<&str>,
+    wing: Option<&str>,
     n_train: Option<usize>,
     noise_free: bool,
     flat: bool,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<Dataset> {
-    let fidelity: Fidelity = fidelity
-        .parse()
-        .map_err(|e| PyValueError::new_err(format!("fidelity: {e}")))?;
+    let (fidelity, wing) = wing_choices(fidelity, wing)?;
     let cfg = SimulateSettings {
         n_trajectories: n,
         n_train,
         seed,
+        wing,
         fidelity,
         noise_free,
         flat,
@@ -332,19 +353,19 @@ pub fn paper_angles<'py>(
 /// Simulates the virtual wing on given Euler angles `(n, 470, 3)` (rad, 25 Hz; the paper's
 /// measured trajectories): the same wing, sensor and split settings as [`simulate`].
 #[pyfunction]
-#[pyo3(signature = (euler_rad, seed, fidelity, n_train=None, noise_free=false, progress=None))]
+#[pyo3(signature = (euler_rad, seed, fidelity=None, wing=None, n_train=None, noise_free=false, progress=None))]
+#[allow(clippy::too_many_arguments)]
 pub fn simulate_angles(
     py: Python<'_>,
     euler_rad: PyReadonlyArray3<'_, f64>,
     seed: u64,
-    fidelity: &str,
+    fidelity: Option<&str>,
+    wing: Option<&str>,
     n_train: Option<usize>,
     noise_free: bool,
     progress: Option<Py<PyAny>>,
 ) -> PyResult<Dataset> {
-    let fidelity: Fidelity = fidelity
-        .parse()
-        .map_err(|e| PyValueError::new_err(format!("fidelity: {e}")))?;
+    let (fidelity, wing) = wing_choices(fidelity, wing)?;
     let (n, t) = (euler_rad.shape()[0], euler_rad.shape()[1]);
     let flat = euler_rad.as_slice()?;
     let angles: Vec<Vec<[f64; 3]>> = (0..n)
@@ -354,6 +375,7 @@ pub fn simulate_angles(
         n_trajectories: n,
         n_train,
         seed,
+        wing,
         fidelity,
         noise_free,
         flat: false,

@@ -8,6 +8,7 @@ mod evaluate;
 mod lrqsm;
 mod progress;
 mod prssm;
+mod rig;
 mod sysid;
 
 use pyo3::prelude::*;
@@ -26,6 +27,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(sysid::sysid, m)?)?;
     m.add_function(wrap_pyfunction!(prssm::train, m)?)?;
     m.add_function(wrap_pyfunction!(evaluate::evaluate, m)?)?;
+    m.add_function(wrap_pyfunction!(rig::rig_check, m)?)?;
     m.add("INPUT_NAMES", flapssm_wing::dataset::INPUT_NAMES.to_vec())?;
     m.add("OUTPUT_NAMES", flapssm_wing::dataset::OUTPUT_NAMES.to_vec())?;
     m.add("INPUT_UNITS", flapssm_wing::dataset::INPUT_UNITS.to_vec())?;

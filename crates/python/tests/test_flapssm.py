@@ -268,3 +268,32 @@ def test_simulation_on_the_papers_measured_trajectories():
     assert np.array_equal(again.outputs, ds.outputs)  # same seed, same dataset
     with pytest.raises(ValueError, match=r"expected \(n, 470, 3\)"):
         flapssm.simulate_angles(euler[:, :400])
+
+
+def test_rig_check_and_wing_settings_equal_the_cli(cli, published, tmp_path):
+    euler = flapssm.paper_angles(6)
+    wing = {"fidelity": "l0", "mount": {"plate_pitch_deg": 4.0}}
+    ds = flapssm.simulate_angles(euler, fidelity="l0", wing=wing, noise_free=True)
+    ds.save(tmp_path / "d.npz")
+    cli("simulate", "--source", "paper", "--n", 6, "--noise-free", "--fidelity", "l0",
+        "--wing-config", _write_json(tmp_path / "w.json", wing), "--out", tmp_path / "c.npz")
+    assert np.array_equal(flapssm.Dataset.load(tmp_path / "c.npz").outputs, ds.outputs)
+    check = flapssm.rig_check(ds, published, out=tmp_path / "rig", lags=False)
+    r = [c["r"] for c in check["train"]["channels"]]
+    assert r[0] > 0.95 and r[3] > 0.95, r
+    assert check["test"] is None and check["train"]["lags"] == []
+    cli("rig", "check", tmp_path / "d.npz", "--reference", published, "--out", tmp_path / "cli", "--no-lags")
+    on_disk = json.loads((tmp_path / "cli" / "rig-check.json").read_text())
+    assert on_disk["train"]["channels"] == check["train"]["channels"]
+    assert (tmp_path / "rig" / "rig-check.md").exists()
+    with pytest.raises(ValueError, match="mount.plate_pich_deg"):
+        flapssm.simulate_angles(euler, wing={"mount": {"plate_pich_deg": 4.0}})
+    with pytest.raises(ValueError, match="--source paper"):
+        flapssm.rig_check(flapssm.simulate(3, seed=1, fidelity="l0"), published)
+    with pytest.raises(FileNotFoundError):
+        flapssm.rig_check(ds, tmp_path / "missing.npz")
+
+
+def _write_json(path, value):
+    path.write_text(json.dumps(value))
+    return path

@@ -20,6 +20,7 @@ use crate::dataset::{Dataset, Trajectory, ValidDataset};
 use crate::dataset::{DatasetMeta, FORMAT_VERSION, Fluid, INPUT_UNITS, OUTPUT_UNITS, WingGeometry};
 use crate::kinematics::{EulerState, WingKinematics, rotation_global_from_wing};
 use crate::lattice::{LatticeError, VortexLatticeParams, VortexLatticeWing};
+use crate::mount::Mount;
 use crate::sensor::{DatasetSensorErrors, SensorConfig, measure};
 use crate::trajectories::{GeneratorConfig, TrajectoryError, TrajectorySpec};
 use crate::vec3::{add, cross};
@@ -37,7 +38,9 @@ pub const GRAVITY_M_S2: f64 = 9.806_65;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
 #[serde(rename_all = "lowercase")]
 pub enum Fidelity {
-    /// Quasi-steady ([`crate::aero::quasi_steady`]).
+    /// Quasi-steady ([`crate::aero::quasi_steady`]): the default wing's, the closest of the
+    /// four to the rig (docs/rig-agreement.md).
+    #[default]
     L0,
     /// Unsteady low-order ([`crate::aero::unsteady`]).
     L1,
@@ -45,9 +48,7 @@ pub enum Fidelity {
     /// wake (the default wing until issue 27; chaotic, with LEV bursts).
     L2,
     /// Unsteady vortex lattice of the whole plate with a prescribed shed wake
-    /// ([`crate::lattice`]): the default wing (issue 27: repeatable, not chaotic, no bursts;
-    /// docs/vortex-method.md, round 14).
-    #[default]
+    /// ([`crate::lattice`]): repeatable, not chaotic, no bursts (docs/vortex-method.md).
     L3,
 }
 
@@ -128,10 +129,15 @@ pub enum SimulateError {
 }
 
 /// The virtual wing: geometry, fluid, fidelity, aerodynamic and sensor parameters.
+///
+/// [`Default`] is the default wing of every command, the one closest to the paper's rig by the
+/// published model's prediction of its loads (docs/rig-agreement.md): the quasi-steady L0
+/// without the chordwise Kirchhoff force, the plate 4.5° off the pitch encoder's zero and the
+/// sensor's axes ([`Mount`]), identified on the paper's 512 training trajectories.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct VirtualWingConfig {
-    /// Aerodynamic fidelity (L3).
+    /// Aerodynamic fidelity (L0).
     pub fidelity: Fidelity,
     /// Plate geometry (0.18 × 0.06 m, r0 = 0.055 m, pitch axis at 15 % chord, U_ref at 0.235 m).
     pub wing: WingGeometry,
@@ -140,9 +146,14 @@ pub struct VirtualWingConfig {
     pub fluid: Fluid,
     /// Sensor origin on the pitch axis, distance from the stroke axis (m; 0.055 = wing root).
     pub sensor_radius_m: f64,
+    /// The plate's and the sensor's angles on the pitch shaft ([`Mount`]; the default wing's
+    /// plate at 4.5°, its sensor at 0°: [`RIG_MOUNT`]).
+    pub mount: Mount,
     /// Blade-element strips (Gauss–Legendre; 8, within 0.5 % of peak of 40 strips).
     pub n_strips: usize,
-    /// L0/L1 parameters (L0 uses only `aero.quasi_steady`).
+    /// L0/L1 parameters (L0 uses only `aero.quasi_steady`; the default wing's has no
+    /// chordwise Kirchhoff force: a sharp-edged plate does not hold the leading-edge suction
+    /// that carries it, and the rig shows none, docs/rig-agreement.md).
     pub aero: UnsteadyParams,
     /// L2 parameters (strip LDVM, docs/vortex-method.md).
     pub l2: StripLdvmParams,
@@ -155,16 +166,27 @@ pub struct VirtualWingConfig {
     pub sensor: SensorConfig,
 }
 
+/// The rig's mount as `flapssm rig fit-mount` identified it on the paper's 512 training
+/// trajectories (plate grid 2–7° by 0.5°, sensor −3–3° by 0.5°, the L0 wing without the
+/// chordwise Kirchhoff force): the plate 4.5° off the encoder's zero and the sensor's axes.
+pub const RIG_MOUNT: Mount = Mount {
+    plate_pitch_deg: 4.5,
+    sensor_pitch_deg: 0.0,
+};
+
 impl Default for VirtualWingConfig {
     fn default() -> Self {
         let wing = WingGeometry::default();
+        let mut aero = UnsteadyParams::default();
+        aero.quasi_steady.added_mass_chordwise = false;
         Self {
-            fidelity: Fidelity::L3,
+            fidelity: Fidelity::L0,
             sensor_radius_m: wing.root_offset_m,
+            mount: RIG_MOUNT,
             wing,
             fluid: Fluid::default(),
             n_strips: 8,
-            aero: UnsteadyParams::default(),
+            aero,
             l2: StripLdvmParams::default(),
             l2_strips: 2,
             l3: VortexLatticeParams::default(),
@@ -174,6 +196,17 @@ impl Default for VirtualWingConfig {
 }
 
 impl VirtualWingConfig {
+    /// The default wing's plate with its aerodynamic levels as their modules define them: the
+    /// plate aligned with the encoder and the sensor, the chordwise Kirchhoff force of L0/L1 on
+    /// (the physics checks' wing).
+    pub fn ideal() -> Self {
+        Self {
+            mount: Mount::default(),
+            aero: UnsteadyParams::default(),
+            ..Self::default()
+        }
+    }
+
     fn blade_geometry(&self) -> BladeGeometry {
         BladeGeometry {
             span_m: self.wing.span_m,
@@ -205,6 +238,13 @@ impl VirtualWingConfig {
             ("sensor.cutoff_hz", self.sensor.cutoff_hz),
             ("wing.u_ref_radius_m", self.wing.u_ref_radius_m),
         ];
+        if let Some((field, value)) = self.mount.out_of_range() {
+            return Err(SimulateError::InvalidConfig {
+                field,
+                value,
+                reason: "must be within ±45°",
+            });
+        }
         if let Some(v) = self.sensor.home_pose_deg.iter().find(|v| !v.is_finite()) {
             return Err(SimulateError::InvalidConfig {
                 field: "sensor.home_pose_deg",
@@ -399,14 +439,20 @@ impl VirtualWing {
         errors: &DatasetSensorErrors,
         rng: &mut ChaCha8Rng,
     ) -> Result<Trajectory, SimulateError> {
+        let mount = self.cfg.mount;
+        let plate_states: std::borrow::Cow<[EulerState]> = if mount.plate_aligned() {
+            states.into()
+        } else {
+            states.iter().map(|st| mount.plate_state(st)).collect()
+        };
         let mut raw = vec![[0.0; 5]; states.len()];
-        self.aero_loads_into(states, sampling.raw_dt_s(), &mut raw);
+        self.aero_loads_into(&plate_states, sampling.raw_dt_s(), &mut raw);
         if let Some(sample) = raw.iter().position(|y| y.iter().any(|v| !v.is_finite())) {
             return Err(SimulateError::NonFinite { index, sample });
         }
-        let (static_loads, inertial_loads): (Vec<[f64; 5]>, Vec<[f64; 5]>) =
+        let (mut static_loads, mut inertial_loads): (Vec<[f64; 5]>, Vec<[f64; 5]>) =
             if self.cfg.sensor.static_residual || self.cfg.sensor.inertial_residual {
-                states.iter().map(|st| self.plate_loads(st)).unzip()
+                plate_states.iter().map(|st| self.plate_loads(st)).unzip()
             } else {
                 (vec![[0.0; 5]; states.len()], vec![[0.0; 5]; states.len()])
             };
@@ -414,13 +460,22 @@ impl VirtualWing {
             angles_rad: self.cfg.sensor.home_pose_deg.map(f64::to_radians),
             ..EulerState::default()
         };
+        let mut home_loads = self.plate_loads(&mount.plate_state(&home)).0;
+        for loads in raw
+            .iter_mut()
+            .chain(&mut static_loads)
+            .chain(&mut inertial_loads)
+            .chain(std::iter::once(&mut home_loads))
+        {
+            mount.plate_to_sensor(loads);
+        }
         let mut outputs = measure(
             &self.cfg.sensor,
             errors,
             &mut raw,
             &static_loads,
             &inertial_loads,
-            &self.plate_loads(&home).0,
+            &home_loads,
             sampling.raw_rate_hz,
             sampling.decimation,
             rng,
@@ -631,6 +686,15 @@ mod tests {
             cfg.check()
         );
         let mut cfg = VirtualWingConfig::default();
+        cfg.mount.plate_pitch_deg = 60.0;
+        assert!(matches!(
+            cfg.check(),
+            Err(SimulateError::InvalidConfig {
+                field: "mount.plate_pitch_deg",
+                ..
+            })
+        ));
+        let mut cfg = VirtualWingConfig::default();
         cfg.wing.chord_m = -0.1;
         assert!(matches!(
             cfg.check(),
@@ -654,6 +718,8 @@ mod tests {
         ));
         let mut cfg = VirtualWingConfig::default();
         cfg.l3.step_chords = 0.0;
+        assert!(cfg.check().is_ok());
+        cfg.fidelity = Fidelity::L3;
         assert!(matches!(
             cfg.check(),
             Err(SimulateError::InvalidL3(LatticeError::InvalidParameter {

@@ -221,7 +221,7 @@ fn wake_capture(n: usize) -> (f64, f64, f64) {
     use flapssm_wing::virtual_wing::{Fidelity, VirtualWing, VirtualWingConfig};
     let sampling = SamplingConfig::default();
     let dt = 1.0 / sampling.raw_rate_hz;
-    let cfg = VirtualWingConfig::default();
+    let cfg = VirtualWingConfig::ideal();
     let lattice =
         || VortexLatticeWing::new(&cfg.l3, &cfg.wing, &cfg.fluid, cfg.sensor_radius_m).unwrap();
     let mut qs_wing = VirtualWing::new(&VirtualWingConfig {
@@ -365,7 +365,7 @@ fn invalid_settings_are_refused_naming_the_field() {
         let cfg = VirtualWingConfig {
             fidelity: Fidelity::L3,
             l3,
-            ..VirtualWingConfig::default()
+            ..VirtualWingConfig::ideal()
         };
         match VirtualWing::new(&cfg) {
             Err(e @ SimulateError::InvalidL3(LatticeError::InvalidParameter { name, .. })) => {

@@ -319,10 +319,11 @@ fn theodorsen_function() {
 use flapssm_wing::trajectories::{Family, GeneratorConfig};
 use flapssm_wing::virtual_wing::{Fidelity, VirtualWing, VirtualWingConfig};
 
+/// The level `fidelity` as its module defines it ([`VirtualWingConfig::ideal`]).
 fn wing(fidelity: Fidelity) -> VirtualWing {
     VirtualWing::new(&VirtualWingConfig {
         fidelity,
-        ..VirtualWingConfig::default()
+        ..VirtualWingConfig::ideal()
     })
     .unwrap()
 }
@@ -387,7 +388,7 @@ fn time_scaling_invariance() {
         // The same Reynolds number: L3's wake cores diffuse with ν (L0 and L1 ignore it).
         let mut fast_cfg = VirtualWingConfig {
             fidelity,
-            ..VirtualWingConfig::default()
+            ..VirtualWingConfig::ideal()
         };
         fast_cfg.fluid.kinematic_viscosity_m2_s *= 2.0;
         VirtualWing::new(&fast_cfg)
@@ -556,7 +557,7 @@ fn default_strip_count_is_converged() {
         let cfg = VirtualWingConfig {
             fidelity: Fidelity::L1,
             n_strips,
-            ..VirtualWingConfig::default()
+            ..VirtualWingConfig::ideal()
         };
         let mut w = VirtualWing::new(&cfg).unwrap();
         let mut y = vec![[0.0; 5]; states.len()];
@@ -952,7 +953,7 @@ fn repeatability_study() {
     for fidelity in [Fidelity::L1, Fidelity::L2] {
         let cfg = VirtualWingConfig {
             fidelity,
-            ..VirtualWingConfig::default()
+            ..VirtualWingConfig::ideal()
         };
         for (cycle, rel) in repeatability(&cfg, 12).iter().enumerate() {
             println!(
@@ -1013,7 +1014,7 @@ fn repeatability(wing_cfg: &VirtualWingConfig, n: usize) -> [[f64; 5]; 4] {
 fn l2_chordwise_loads_forget_how_the_motion_began() {
     let cfg = VirtualWingConfig {
         fidelity: Fidelity::L2,
-        ..VirtualWingConfig::default()
+        ..VirtualWingConfig::ideal()
     };
     let second = repeatability(&cfg, 4)[1];
     assert!(second[1] < 0.15 && second[2] < 0.15, "{second:?}");
@@ -1085,7 +1086,7 @@ fn l2_wake_motion_study() {
 fn l3_study() {
     let cfg = VirtualWingConfig {
         fidelity: Fidelity::L3,
-        ..VirtualWingConfig::default()
+        ..VirtualWingConfig::ideal()
     };
     let mut w = VirtualWing::new(&cfg).unwrap();
     let flat = figure_eight_hover(&mut w, 0.0).mean_cl;
@@ -1189,7 +1190,7 @@ fn l3_has_no_bursts() {
 fn l3_forgets_how_the_motion_began() {
     let cfg = VirtualWingConfig {
         fidelity: Fidelity::L3,
-        ..VirtualWingConfig::default()
+        ..VirtualWingConfig::ideal()
     };
     let third = repeatability(&cfg, 12)[2];
     assert!(third.iter().all(|d| *d < 0.1), "{third:?}");

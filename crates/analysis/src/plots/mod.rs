@@ -9,6 +9,8 @@
 //! | [`timeseries`] | Fig. 3: chord sketches, kinematics, measured vs predicted C_Fx/C_Fy with ±2σ |
 //! | [`errors`] | Fig. 4: standardized-error histograms with intervals; half-stroke averages |
 //! | [`authority`] | Fig. 5: HDR contours and modes, per-pair scatter, summary circle grid |
+//! | [`hovering`] | the published hovering case: C_L and C_D histories of several sources |
+//! | [`rig`] | the rig check: a dataset's standardized loads over the reference's mean and 95 % band |
 //! | [`wing3d`] | Fig. 2C: 3-D wing-motion sketches (chord lines along the path, LE dotted) |
 //! | [`training`] | training curves |
 //! | [`sweep`] | accuracy against a swept setting (D_x, training-set size) |
@@ -24,6 +26,8 @@ use crate::error::{AnalysisError, Result};
 
 pub mod authority;
 pub mod errors;
+pub mod hovering;
+pub mod rig;
 pub mod sweep;
 pub mod sysid;
 pub mod timeseries;

@@ -46,11 +46,17 @@ pub struct DemoArgs {
     /// Override the number of training particles.
     #[arg(long)]
     particles: Option<usize>,
-    /// Override the virtual wing's aerodynamic fidelity: l0 (quasi-steady), l1 (unsteady
-    /// low-order), l2 (vortex strips), l3 (vortex lattice, the default wing of the demo and of
-    /// `simulate`).
+    /// Override the virtual wing's aerodynamic fidelity: l0 (quasi-steady, the default wing of
+    /// the demo and of `simulate`), l1 (unsteady low-order), l2 (vortex strips), l3 (vortex
+    /// lattice).
     #[arg(long, value_name = "LEVEL")]
     fidelity: Option<String>,
+    /// Check the dataset against this reference model of the rig (the published
+    /// …/bayiz2021-prssm/reference.npz, or a model imported from it): the rig agreement heads
+    /// the report and enters summary.json (needs the paper's trajectories: --full or --source
+    /// paper; docs/rig-agreement.md).
+    #[arg(long, value_name = "FILE")]
+    reference: Option<PathBuf>,
     /// Override the fraction of the training trajectories held out for validation (default
     /// 0.1; with --full 0, the published protocol).
     #[arg(long, value_name = "F")]
@@ -118,6 +124,7 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
         cfg.training.objective = o.into();
     }
     args.training.apply(&mut cfg.training);
+    cfg.rig_reference = args.reference;
     let stop = stop_flag()?;
     let bars = Bars::new();
     let s = run_demo(&args.out, &cfg, &bars, Some(&stop))
@@ -157,6 +164,15 @@ pub fn run(args: DemoArgs) -> anyhow::Result<()> {
         s.ratio_target,
         if s.ratio_target_met { "met" } else { "NOT met" }
     );
+    if let Some(rig) = &s.rig_agreement {
+        let r = |a: &flapssm_jobs::rig::SetAgreement| {
+            f(&a.channels.iter().map(|c| c.r).collect::<Vec<_>>())
+        };
+        println!("rig agreement r (train) {}", r(&rig.train));
+        if let Some(test) = &rig.test {
+            println!("rig agreement r (test)  {}", r(test));
+        }
+    }
     println!(
         "AoA / a_x on the output states: median lag {:.3} / {:.3}, KDE-mode lag {:.3} / {:.3} cycles",
         s.aoa_median_lag_cycles,

@@ -8,6 +8,9 @@ use flapssm_jobs::evaluate::{EVALUATION_FILES, EvalOptions, ReportContext, evalu
 use flapssm_jobs::models::lrqsm::LrqsmLoadModel;
 use flapssm_jobs::models::prssm::PrssmLoadModel;
 use flapssm_jobs::models::{LoadModel, baseline};
+use flapssm_jobs::rig::{
+    RIG_FILES, RigSettings, load_reference_model, rig_check, rig_reference, write_rig_check,
+};
 use flapssm_prssm::PrssmModel;
 use flapssm_qs::LrqsmModel;
 use flapssm_wing::dataset::Dataset;
@@ -44,16 +47,30 @@ pub struct EvaluateArgs {
     /// First analysed sample (0-based; published 93).
     #[arg(long, default_value_t = 93)]
     start_sample: usize,
+    /// Also check the dataset (the paper's trajectories, `simulate --source paper`) against this
+    /// reference model of the rig (…/bayiz2021-prssm/reference.npz or a model imported from
+    /// it): rig-check.json, rig-check.md, rig-examples.png and a report section
+    /// (docs/rig-agreement.md).
+    #[arg(long, value_name = "FILE")]
+    reference: Option<PathBuf>,
 }
 
 /// Runs `flapssm evaluate`.
 pub fn run(a: EvaluateArgs) -> anyhow::Result<()> {
-    let inputs: Vec<&Path> = [Some(&a.dataset), a.prssm.as_ref(), a.lrqsm.as_ref()]
-        .into_iter()
-        .flatten()
-        .map(PathBuf::as_path)
-        .collect();
+    let inputs: Vec<&Path> = [
+        Some(&a.dataset),
+        a.prssm.as_ref(),
+        a.lrqsm.as_ref(),
+        a.reference.as_ref(),
+    ]
+    .into_iter()
+    .flatten()
+    .map(PathBuf::as_path)
+    .collect();
     flapssm_jobs::files::check_output_dir(&a.out, &EVALUATION_FILES, &inputs)?;
+    if a.reference.is_some() {
+        flapssm_jobs::files::check_output_dir(&a.out, &RIG_FILES, &inputs)?;
+    }
     let opts = EvalOptions {
         particles: a.particles,
         seed: a.seed,
@@ -105,6 +122,25 @@ pub fn run(a: EvaluateArgs) -> anyhow::Result<()> {
         models.push(m);
     }
     models.extend(baselines.iter().map(|m| &**m));
+    let rig_section = match &a.reference {
+        Some(path) => {
+            let model = load_reference_model(path)?;
+            let reference = rig_reference(&model, ds.len(), &RigSettings::default(), &bars)
+                .context("predicting the rig reference")?;
+            let check = rig_check(&ds, &reference, true)
+                .with_context(|| format!("checking {} against the rig", a.dataset.display()))?;
+            write_rig_check(
+                &a.out,
+                &check,
+                &ds,
+                &reference,
+                &a.dataset.display().to_string(),
+            )?;
+            let figure = a.out.join(RIG_FILES[2]);
+            Some(check.report_section(figure.exists().then_some(figure)))
+        }
+        None => None,
+    };
     let ctx = ReportContext {
         intro: format!(
             "{} evaluated on {}.",
@@ -117,7 +153,9 @@ pub fn run(a: EvaluateArgs) -> anyhow::Result<()> {
         ),
         config: serde_json::json!({
             "dataset": a.dataset, "prssm": a.prssm, "lrqsm": a.lrqsm, "baselines": a.baseline,
+            "reference": a.reference,
         }),
+        extra_sections: rig_section.into_iter().collect(),
         ..ReportContext::default()
     };
     let r = evaluate(

@@ -8,6 +8,7 @@ pub mod evaluate;
 pub mod model;
 pub mod predict;
 pub mod qs;
+pub mod rig;
 pub mod simulate;
 pub mod stream;
 pub mod sweep;

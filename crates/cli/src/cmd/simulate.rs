@@ -26,9 +26,15 @@ pub struct SimulateArgs {
     #[arg(long, value_name = "S", default_value_t = 0)]
     seed: u64,
     /// Aerodynamic fidelity: l0 (quasi-steady), l1 (unsteady low-order), l2 (vortex strips), l3
-    /// (vortex lattice of the whole plate with a prescribed wake, the default wing).
-    #[arg(long, value_name = "LEVEL", default_value = "l3")]
-    fidelity: String,
+    /// (vortex lattice of the whole plate with a prescribed wake). Default: the wing's
+    /// (`--wing-config`, else the default wing).
+    #[arg(long, value_name = "LEVEL")]
+    fidelity: Option<String>,
+    /// The wing as a JSON file of `VirtualWingConfig` fields (geometry, fluid, fidelity,
+    /// aerodynamic, sensor-pose and sensor settings; a missing field keeps the default wing's,
+    /// an unknown one is refused). The options above apply on top of it.
+    #[arg(long, value_name = "FILE")]
+    wing_config: Option<PathBuf>,
     /// Output dataset file (.npz).
     #[arg(long, value_name = "FILE")]
     out: PathBuf,
@@ -59,12 +65,25 @@ pub struct SimulateArgs {
 /// Runs `flapssm simulate`.
 pub fn run(args: SimulateArgs) -> anyhow::Result<()> {
     let start = Instant::now();
-    flapssm_jobs::files::check_outputs(&[&args.out], &[])?;
-    let fidelity: Fidelity = args.fidelity.parse().context("parsing --fidelity")?;
+    let inputs: Vec<&std::path::Path> = args.wing_config.iter().map(|p| p.as_path()).collect();
+    flapssm_jobs::files::check_outputs(&[&args.out], &inputs)?;
+    let fidelity: Option<Fidelity> = args
+        .fidelity
+        .map(|f| f.parse().context("parsing --fidelity"))
+        .transpose()?;
+    let wing = args
+        .wing_config
+        .as_deref()
+        .map(|path| {
+            flapssm_jobs::files::load_config(path)
+                .with_context(|| format!("reading wing configuration {}", path.display()))
+        })
+        .transpose()?;
     let settings = SimulateSettings {
         n_trajectories: args.n,
         n_train: args.n_train,
         seed: args.seed,
+        wing,
         fidelity,
         noise_free: args.noise_free,
         flat: args.flat,
@@ -102,7 +121,7 @@ pub fn run(args: SimulateArgs) -> anyhow::Result<()> {
         },
         ds.n_train,
         cfg.trajectories.sampling.n_samples,
-        fidelity,
+        cfg.wing.fidelity,
         if args.noise_free {
             "noise-free"
         } else {

@@ -232,6 +232,7 @@ pub(super) fn html_report(
             ..Default::default()
         });
     }
+    sections.extend(ctx.extra_sections.iter().cloned());
     sections.push(Section {
         heading: "Accuracy".into(),
         paragraphs: vec![format!(

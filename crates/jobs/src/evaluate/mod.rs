@@ -315,6 +315,8 @@ pub struct ReportContext {
     pub headline: Vec<(String, String)>,
     /// Configuration shown in the report.
     pub config: serde_json::Value,
+    /// Sections placed after the paper comparison (e.g. the rig check, [`crate::rig`]).
+    pub extra_sections: Vec<flapssm_analysis::report::Section>,
 }
 
 /// Evaluates `models` on `ds` and writes into `out_dir`: `metrics.json`

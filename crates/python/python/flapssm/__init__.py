@@ -43,6 +43,7 @@ __all__ = [
     "sysid",
     "train",
     "evaluate",
+    "rig_check",
     "LRQSMRegressor",
     "PRSSMRegressor",
 ]
@@ -75,36 +76,45 @@ def dataset_from_arrays(
     return _native.Dataset.from_arrays(e, u, y, n if n_train is None else int(n_train), float(dt_s), r)
 
 
+def _wing_json(wing: Optional[dict]) -> Optional[str]:
+    return None if wing is None else json.dumps(wing)
+
+
 def simulate(
     n: int = 548,
     seed: int = 0,
-    fidelity: str = "l3",
+    fidelity: Optional[str] = None,
     n_train: Optional[int] = None,
     noise_free: bool = False,
     flat: bool = False,
     progress: Optional[Progress] = None,
+    wing: Optional[dict] = None,
 ) -> "_native.Dataset":
     """Simulates the virtual wing on ``n`` generated trajectories (``flapssm simulate``):
     the same seed gives the same dataset as the CLI. ``fidelity``: ``l0`` quasi-steady,
-    ``l1`` unsteady low-order, ``l2`` vortex strips, ``l3`` vortex lattice (the default wing).
+    ``l1`` unsteady low-order, ``l2`` vortex strips, ``l3`` vortex lattice (default: the
+    wing's). ``wing``: a dict of wing settings over the default wing, as the JSON file of
+    ``flapssm simulate --wing-config`` (an unknown field raises ``ValueError``).
     ``progress(stage, position, total)``."""
-    return _native.simulate(int(n), int(seed), fidelity, n_train, noise_free, flat, progress)
+    return _native.simulate(int(n), int(seed), fidelity, _wing_json(wing), n_train, noise_free, flat, progress)
 
 
 def simulate_angles(
     euler_rad: Any,
     seed: int = 0,
-    fidelity: str = "l3",
+    fidelity: Optional[str] = None,
     n_train: Optional[int] = None,
     noise_free: bool = False,
     progress: Optional[Progress] = None,
+    wing: Optional[dict] = None,
 ) -> "_native.Dataset":
     """Simulates the virtual wing on given Euler angles ``(n, 470, 3)`` [φ, ψ, α] (rad) at
     25 Hz — for example the paper's 548 measured trajectories (:func:`paper_angles`): rates and
     accelerations by a Savitzky–Golay fit, quintic Hermite interpolation to the wing's 250 Hz,
-    then the aerodynamics and the sensor chain as in :func:`simulate`."""
+    then the aerodynamics and the sensor chain as in :func:`simulate` (``fidelity`` and ``wing``
+    likewise)."""
     e = as_float_array("euler_rad", euler_rad, (None, 470, 3))
-    return _native.simulate_angles(e, int(seed), fidelity, n_train, noise_free, progress)
+    return _native.simulate_angles(e, int(seed), fidelity, _wing_json(wing), n_train, noise_free, progress)
 
 
 def paper_angles(n: Optional[int] = None) -> np.ndarray:
@@ -217,6 +227,29 @@ def evaluate(
     intervals, half-stroke averages, control authority of the latent states, figures and
     ``report.html`` in ``out``; returns ``metrics.json`` as a dict."""
     text = _native.evaluate(dataset, os.fspath(out), prssm, lrqsm, particles, seed, start_sample, progress)
+    return json.loads(text)
+
+
+def rig_check(
+    dataset: "_native.Dataset",
+    reference: PathLike,
+    out: Optional[PathLike] = None,
+    particles: int = 30,
+    seed: int = 1,
+    lags: bool = True,
+    progress: Optional[Progress] = None,
+) -> dict:
+    """The rig as the judge (``flapssm rig check``): ``dataset`` — the paper's trajectories
+    0..n in the authors' order, for example ``simulate_angles(paper_angles(), noise_free=True)``
+    — against the published model's prediction of the rig's loads (``reference``: its
+    ``reference.npz`` or an imported model file), on the paper's 512 training and 36 test
+    trajectories: per channel ``r``, ``z_rmse`` and ``band_share``, the couplings and (with
+    ``lags``) the Fig. 5 lag statistics. With ``out``, writes ``rig-check.json``,
+    ``rig-check.md`` and ``rig-examples.png`` there. Returns ``rig-check.json`` as a dict."""
+    text = _native.rig_check(
+        dataset, os.fspath(reference), None if out is None else os.fspath(out),
+        int(particles), int(seed), bool(lags), progress,
+    )
     return json.loads(text)
 
 

@@ -114,6 +114,10 @@ pub struct VortexLatticeParams {
     pub inflow: Inflow,
     /// Travel over which the inflow averages the lift, in chords (default 4, as the strips).
     pub inflow_window_chords: f64,
+    /// Include the unsteady term −ρ ∂Γ/∂t ΔS of the normal force (default true): the plate's
+    /// added mass and the growth of its circulation. Off only to measure its share (the rig
+    /// ablation of docs/rig-agreement.md).
+    pub unsteady_term: bool,
 }
 
 impl Default for VortexLatticeParams {
@@ -128,6 +132,7 @@ impl Default for VortexLatticeParams {
             profile_drag: zero_incidence_drag(),
             inflow: Inflow::Momentum,
             inflow_window_chords: 4.0,
+            unsteady_term: true,
         }
     }
 }

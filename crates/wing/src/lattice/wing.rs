@@ -355,7 +355,7 @@ impl VortexLatticeWing {
         };
         let gamma = |i: usize, j: usize| s.gamma[i * ns + j];
         let wake_at = |i: usize, j: usize| s.wake_velocity[i * ns + j];
-        let rate = if dt_s > 0.0 && s.started {
+        let rate = if dt_s > 0.0 && s.started && self.params.unsteady_term {
             1.0 / dt_s
         } else {
             0.0

@@ -74,6 +74,14 @@ pub enum TrajectoryError {
         /// Cause.
         source: CycleError,
     },
+    /// Differentiating measured angles failed.
+    #[error("trajectory {index}: differentiating the measured angles: {source}")]
+    Differentiate {
+        /// Trajectory index.
+        index: usize,
+        /// Cause.
+        source: crate::differentiate::DifferentiateError,
+    },
     /// The assembled dataset failed [`Dataset::validate`].
     #[error("the generated dataset is invalid: {0}")]
     Invalid(#[from] DatasetError),

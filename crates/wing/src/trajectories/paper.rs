@@ -23,7 +23,11 @@
 //! (figure-eight), #13 too, lowest mid-stroke (U), #33 by under 4° (flat), #5 and #32 at the
 //! stroke frequency (oval); see `tests/paper_trajectories.rs`.
 
-use super::SamplingConfig;
+use super::{SamplingConfig, TrajectoryError, measured};
+use crate::cycles::{self, U_REF_RADIUS_M};
+use crate::dataset::{Dataset, DatasetMeta, FORMAT_VERSION, Fluid, INPUT_UNITS, OUTPUT_UNITS};
+use crate::dataset::{Trajectory, ValidDataset, WingGeometry};
+use crate::kinematics::WingKinematics;
 
 /// Number of measured trajectories.
 pub const PAPER_N_TRAJECTORIES: usize = 548;
@@ -64,6 +68,62 @@ pub fn paper_angles(n: usize) -> Vec<Vec<[f64; 3]>> {
 /// 470 samples), which is the robot's.
 pub fn paper_sampling() -> SamplingConfig {
     SamplingConfig::default()
+}
+
+/// The paper's trajectories `0..n` (n ≤ 548) as a kinematics-only dataset: the Euler angles,
+/// inputs and U_ref at 25 Hz of the smoothed measured angles ([`measured::raw_states`] at its
+/// knots), exactly as a noise-free `simulate --source paper` computes them; the first
+/// min(n, 512) train, family `measured`, no outputs.
+///
+/// # Errors
+/// [`TrajectoryError::Differentiate`] or [`TrajectoryError::Cycle`] naming the trajectory
+/// (never for the vendored file); an empty `n` gives an invalid dataset.
+pub fn paper_kinematics(n: usize) -> Result<ValidDataset, TrajectoryError> {
+    let sampling = paper_sampling();
+    let dt_s = sampling.dataset_dt_s();
+    let trajectories = paper_angles(n)
+        .iter()
+        .enumerate()
+        .map(|(index, angles)| {
+            let states = measured::raw_states(angles, &sampling)
+                .map_err(|source| TrajectoryError::Differentiate { index, source })?;
+            let knots: Vec<_> = states
+                .iter()
+                .step_by(sampling.decimation.max(1))
+                .take(sampling.n_samples)
+                .collect();
+            let euler_rad: Vec<[f64; 3]> = knots.iter().map(|s| s.angles_rad).collect();
+            let inputs = knots
+                .iter()
+                .map(|s| WingKinematics::from_euler(s).inputs())
+                .collect();
+            let (u_ref_m_s, _) = cycles::published_u_ref(&euler_rad, dt_s, U_REF_RADIUS_M)
+                .map_err(|source| TrajectoryError::Cycle { index, source })?;
+            Ok(Trajectory {
+                euler_rad,
+                inputs,
+                outputs: None,
+                u_ref_m_s,
+                family: "measured".to_string(),
+            })
+        })
+        .collect::<Result<Vec<_>, TrajectoryError>>()?;
+    let ds = Dataset {
+        meta: DatasetMeta {
+            format_version: FORMAT_VERSION,
+            wing: WingGeometry::default(),
+            fluid: Fluid::default(),
+            generator: "flapssm (the paper's measured trajectories)".to_string(),
+            seed: None,
+            settings: serde_json::json!({ "angles_source": "crates/wing/data/bayiz2021-euler-angles.npy", "signs": PAPER_ANGLE_SIGNS }),
+            input_units: INPUT_UNITS.iter().map(|s| s.to_string()).collect(),
+            output_units: OUTPUT_UNITS.iter().map(|s| s.to_string()).collect(),
+        },
+        dt_s,
+        n_train: trajectories.len().min(PAPER_N_TRAIN),
+        trajectories,
+    };
+    Ok(ValidDataset::new(ds)?)
 }
 
 #[cfg(test)]
