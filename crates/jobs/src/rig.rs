@@ -611,6 +611,11 @@ pub struct MountPoint {
 }
 
 impl MountPoint {
+    /// Mean z-MSE over the five channels.
+    pub fn mean_mse(&self) -> f64 {
+        self.z_mse.iter().sum::<f64>() / self.z_mse.len() as f64
+    }
+
     /// Mean z-MSE of the normal channels F_x, M_y, M_z (the plate angle's criterion).
     pub fn normal_mse(&self) -> f64 {
         (self.z_mse[0] + self.z_mse[3] + self.z_mse[4]) / 3.0
@@ -635,6 +640,9 @@ pub struct MountFit {
     pub at_best: SetAgreement,
     /// The agreement with both angles 0.
     pub aligned: SetAgreement,
+    /// The grid point of the smallest mean z-MSE over all five channels, for comparison (not
+    /// the fit's criterion: see [`fit_mount`]).
+    pub all_channels_best: MountPoint,
     /// Every grid point, plate-major.
     pub surface: Vec<MountPoint>,
 }
@@ -751,6 +759,11 @@ pub fn fit_mount(
             value: "[]".into(),
             expected: "at least one angle".into(),
         })?;
+    let all_channels_best = surface
+        .iter()
+        .min_by(|a, b| a.mean_mse().total_cmp(&b.mean_mse()))
+        .cloned()
+        .unwrap_or_else(|| best.clone());
     let at_best = agreement_at(&simulate(best.plate_deg, &tick)?, best.sensor_deg)?;
     progress.finish("");
     Ok(MountFit {
@@ -766,6 +779,7 @@ pub fn fit_mount(
             value: "[]".into(),
             expected: "0° in the grid".into(),
         })?,
+        all_channels_best,
         surface,
     })
 }

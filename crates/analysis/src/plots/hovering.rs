@@ -70,7 +70,7 @@ pub fn lift_drag<'a>(
                 .y_label_area_size(50)
                 .build_cartesian_2d(from..to, y0..y1)?;
             ch.configure_mesh()
-                .light_line_style(RGBColor(238, 238, 238))
+                .max_light_lines(1)
                 .x_desc("t/T")
                 .y_desc(name)
                 .label_style(font(13.0))

@@ -24,7 +24,7 @@ pub struct RigPanel<'a> {
     pub reference_var_z: &'a [f64],
 }
 
-/// Draws the panels into `path` (`.png`/`.svg`; 360 × 1100 px per column): the reference's
+/// Draws the panels into `path` (`.png`/`.svg`; 320 × 1000 px per column): the reference's
 /// mean (orange) with its 95 % band, the dataset's loads (black), labelled `dataset_label`.
 ///
 /// # Errors
@@ -56,7 +56,7 @@ pub fn rig_overlay(
         }
     }
     let cols = panels.len();
-    render!(path, (360 * cols as u32, 1100), |root| {
+    render!(path, (320 * cols as u32, 1000), |root| {
         let area = root.titled(title, bold(18.0))?;
         let columns = area.split_evenly((1, cols));
         let reference = PALETTE[1];
@@ -87,7 +87,7 @@ pub fn rig_overlay(
                     String::new()
                 };
                 ch.configure_mesh()
-                    .light_line_style(RGBColor(238, 238, 238))
+                    .max_light_lines(1)
                     .x_desc(if k == 4 { "t (s)" } else { "" })
                     .y_desc(y_desc)
                     .label_style(font(11.0))

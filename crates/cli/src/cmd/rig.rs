@@ -218,7 +218,8 @@ fn fit(a: FitMountArgs) -> anyhow::Result<()> {
     println!(
         "fidelity {:?}, {} training trajectories: plate θ_p = {}°, sensor θ_s = {}° (loads turned by {}°)\n  \
          at the fit: r {}; r(F_y, F_x) {:.3}, r(M_x, F_x) {:.3} (stand-in {:.3}, {:.3})\n  \
-         aligned:    r {}; r(F_y, F_x) {:.3}, r(M_x, F_x) {:.3}\n-> {} ({:.1} s)",
+         aligned:    r {}; r(F_y, F_x) {:.3}, r(M_x, F_x) {:.3}\n  \
+         (the smallest mean z-MSE over all five channels lies at θ_p = {}°, θ_s = {}°: r(F_y, F_x) {:.3}, r(M_x, F_x) {:.3})\n-> {} ({:.1} s)",
         result.fidelity,
         result.n_trajectories,
         result.best.plate_pitch_deg,
@@ -232,6 +233,10 @@ fn fit(a: FitMountArgs) -> anyhow::Result<()> {
         r(aligned),
         aligned.dataset_couplings.fy_fx,
         aligned.dataset_couplings.mx_fx,
+        result.all_channels_best.plate_deg,
+        result.all_channels_best.sensor_deg,
+        result.all_channels_best.fy_fx,
+        result.all_channels_best.mx_fx,
         a.out.display(),
         start.elapsed().as_secs_f64()
     );
