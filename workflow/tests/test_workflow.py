@@ -2,8 +2,8 @@
 kind × value × seed and their merge; one demo per seed and their merge), the merged sweep table
 carries the paper's two selection rows with the spread over seeds, the merged demos one row per
 seed and the paper's rows per seed, a second invocation has nothing to do, a lost result is
-rerun from its run's checkpoint, and the Slurm profile plans the same jobs (dry run; no cluster
-here). The paper's two configurations plan their 14 runs each (dry run; the size curve's 512 is
+rerun from its run's checkpoint, and the Slurm profile plans the same jobs (dry run; the real
+cluster's tests are test_slurm.py); a bad job resource is named before any job. The paper's two configurations plan their 14 runs each (dry run; the size curve's 512 is
 the dx 12 run), the fast one with the fast preset; the paper's experiment on three seeds plans
 three `demo --full --preset paper-fast` runs (a `true` option is a bare switch)."""
 
@@ -21,7 +21,9 @@ WORKFLOW = ROOT / "workflow"
 FLAPSSM = Path(os.environ.get("FLAPSSM", ROOT / "target" / "release" / "flapssm"))
 
 
-def snakemake(*args, cwd, config="tiny.yaml"):
+def snakemake(*args, cwd, config="tiny.yaml", start=False):
+    """Runs Snakemake on `config` (a file of workflow/config, or a path) in `cwd`; with `start`,
+    returns the running process instead of waiting for it."""
     exe = shutil.which("snakemake", path=str(Path(sys.executable).parent)) or shutil.which(
         "snakemake"
     )
@@ -32,14 +34,16 @@ def snakemake(*args, cwd, config="tiny.yaml"):
         "--snakefile",
         str(WORKFLOW / "Snakefile"),
         "--configfile",
-        str(WORKFLOW / "config" / config),
+        str(config if Path(str(config)).is_absolute() else WORKFLOW / "config" / config),
         "--config",
         f"flapssm={FLAPSSM}",
         "--directory",
         str(cwd),
         *args,
     ]
-    return subprocess.run(cmd, capture_output=True, text=True, timeout=600)
+    if start:
+        return subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    return subprocess.run(cmd, capture_output=True, text=True, timeout=900)
 
 
 def assert_planned(out, counts):
@@ -129,3 +133,14 @@ def test_the_full_demo_on_three_seeds_plans_switches(tmp_path):
     runs = [line for line in (r.stdout + r.stderr).splitlines() if " demo --out " in line]
     assert len(runs) == 3, runs
     assert all("--full --preset paper-fast" in line and "True" not in line for line in runs), runs
+
+
+def test_a_bad_job_resource_is_named_before_any_job(tmp_path):
+    bad = tmp_path / "bad.yaml"
+    text = (WORKFLOW / "config" / "tiny.yaml").read_text().replace("mem_mb: 1000", "mem_mb: 0")
+    bad.write_text(text)
+    r = snakemake("--profile", str(WORKFLOW / "profiles" / "local"), cwd=tmp_path / "run", config=bad)
+    assert r.returncode != 0
+    assert "config mem_mb: 0 is not a whole number >= 1" in r.stdout + r.stderr, r.stderr[-2000:]
+    assert not (tmp_path / "run" / "data").exists()
+
