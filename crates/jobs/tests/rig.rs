@@ -101,6 +101,26 @@ fn the_check_ranks_the_wings_on_a_subset() {
     );
 }
 
+/// With its sensor chain the default wing keeps the stand-in's chordwise signature on every
+/// seed: the couplings' signs and r(F_y) well above zero (with a random cross-axis coupling of
+/// 1 % of full scale, seeds 1–3 of 0–3 reversed F_y's coupling, docs/rig-agreement.md).
+#[test]
+fn the_default_dataset_keeps_the_rigs_chordwise_signature_on_every_seed() {
+    let reference = reference(N);
+    for seed in 0..4 {
+        let settings = SimulateSettings {
+            n_trajectories: N,
+            seed,
+            ..SimulateSettings::default()
+        };
+        let ds = simulate_paper(&settings, &NoProgress).unwrap();
+        let check = rig_check(&ds, &reference, false).unwrap().train;
+        let c = check.dataset_couplings;
+        assert!(c.fy_fx > 0.6 && c.mx_fx < -0.8, "seed {seed}: {c:?}");
+        assert!(check.channels[1].r > 0.5, "seed {seed}: {:?}", check.channels[1]);
+    }
+}
+
 /// The reference's inputs are the noise-free simulation's, and a dataset that is not the
 /// paper's trajectories, or has no loads, is refused by name.
 #[test]

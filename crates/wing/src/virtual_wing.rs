@@ -133,7 +133,8 @@ pub enum SimulateError {
 /// [`Default`] is the default wing of every command, the one closest to the paper's rig by the
 /// published model's prediction of its loads (docs/rig-agreement.md): the quasi-steady L0
 /// without the chordwise Kirchhoff force, the plate 4.5° off the pitch encoder's zero and the
-/// sensor's axes ([`Mount`]), identified on the paper's 512 training trajectories.
+/// sensor's axes ([`Mount`]), identified on the paper's 512 training trajectories, and the
+/// sensor chain without random cross-axis coupling (the mount is the rig's coupling).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct VirtualWingConfig {
@@ -162,7 +163,10 @@ pub struct VirtualWingConfig {
     pub l2_strips: usize,
     /// L3 parameters (vortex lattice, [`crate::lattice`]).
     pub l3: VortexLatticeParams,
-    /// Sensor and post-processing.
+    /// Sensor and post-processing (the default wing's: [`SensorConfig::default`] without the
+    /// random cross-axis coupling — the rig's chordwise channels follow its normal force with
+    /// one sign, which a coupling of 1 % of full scale would make a coin toss, and the mount
+    /// already is the rig's coupling; docs/rig-agreement.md).
     pub sensor: SensorConfig,
 }
 
@@ -187,22 +191,26 @@ impl Default for VirtualWingConfig {
             fluid: Fluid::default(),
             n_strips: 8,
             aero,
+            sensor: SensorConfig {
+                cross_axis: false,
+                ..SensorConfig::default()
+            },
             l2: StripLdvmParams::default(),
             l2_strips: 2,
             l3: VortexLatticeParams::default(),
-            sensor: SensorConfig::default(),
         }
     }
 }
 
 impl VirtualWingConfig {
-    /// The default wing's plate with its aerodynamic levels as their modules define them: the
-    /// plate aligned with the encoder and the sensor, the chordwise Kirchhoff force of L0/L1 on
-    /// (the physics checks' wing).
+    /// The default wing's plate with its aerodynamic levels and sensor chain as their modules
+    /// define them: the plate aligned with the encoder and the sensor, the chordwise Kirchhoff
+    /// force of L0/L1 on, the random cross-axis coupling on (the physics checks' wing).
     pub fn ideal() -> Self {
         Self {
             mount: Mount::default(),
             aero: UnsteadyParams::default(),
+            sensor: SensorConfig::default(),
             ..Self::default()
         }
     }
