@@ -49,9 +49,9 @@ fn tiny_demo_evaluate_and_sweep() {
         assert!(p[j] > 0.0 && p[j].is_finite() && l[j] > 0.0 && l[j].is_finite());
         assert!((r[j] - p[j] / l[j]).abs() < 1e-12 * r[j].abs().max(1.0));
     }
-    assert_eq!(
-        s["ratio_target_met"].as_bool().unwrap(),
-        r.iter().all(|v| *v <= 0.6)
+    assert!(
+        s.get("ratio_target_met").is_none(),
+        "the project's old 0.6 target is not one of the paper's measures"
     );
     let lag = s["a_x_median_lag_cycles"].as_f64().unwrap();
     assert!(

@@ -5,7 +5,7 @@ use std::path::Path;
 
 use plotters::prelude::*;
 
-use super::{PALETTE, bold, font, padded_range, render};
+use super::{bold, font, model_colour, padded_range, render};
 use crate::error::{AnalysisError, Result};
 use crate::metrics::Histogram;
 use crate::stats::central_interval;
@@ -89,7 +89,7 @@ pub fn error_histograms(
                 .label_style(font(13.0))
                 .draw()?;
             for (m, model) in models.iter().enumerate() {
-                let col = PALETTE[m % PALETTE.len()];
+                let col = model_colour(m);
                 let h = &hists[m][j];
                 ch.draw_series(h.probability.iter().enumerate().map(|(k, &p)| {
                     Rectangle::new(
@@ -226,7 +226,7 @@ pub fn cycle_average_scatter(
                 BLACK.stroke_width(1),
             ))?;
             for (m, model) in models.iter().enumerate() {
-                let col = PALETTE[m % PALETTE.len()];
+                let col = model_colour(m);
                 ch.draw_series(
                     model.observed[j]
                         .iter()

@@ -48,6 +48,12 @@ pub const PALETTE: [RGBColor; 7] = [
     RGBColor(162, 20, 47),
 ];
 
+/// The colour of the `i`-th model in every figure that compares models: each model its own
+/// (up to the palette's 7), the measured loads black.
+pub fn model_colour(i: usize) -> RGBColor {
+    PALETTE[i % PALETTE.len()]
+}
+
 /// Font family name used by every figure.
 pub const FONT: &str = "sans-serif";
 
@@ -220,5 +226,16 @@ mod tests {
         );
         assert_eq!(Format::from_path(Path::new("b.svg")).unwrap(), Format::Svg);
         assert!(Format::from_path(Path::new("b.pdf")).is_err());
+    }
+
+    #[test]
+    fn each_model_has_its_own_colour() {
+        let colours: Vec<_> = (0..PALETTE.len()).map(model_colour).collect();
+        for (i, a) in colours.iter().enumerate() {
+            assert_ne!((a.0, a.1, a.2), (0, 0, 0), "black is the measured loads'");
+            for b in &colours[i + 1..] {
+                assert_ne!((a.0, a.1, a.2), (b.0, b.1, b.2));
+            }
+        }
     }
 }

@@ -11,7 +11,7 @@ use std::path::Path;
 
 use plotters::prelude::*;
 
-use super::{PALETTE, bold, font, padded_range, render};
+use super::{PALETTE, bold, font, model_colour, padded_range, render};
 use crate::error::{AnalysisError, Result};
 
 /// Coefficient curves of one source (measurement or model).
@@ -241,7 +241,7 @@ pub fn time_histories<'a>(
                     .label_style(font(12.0))
                     .draw()?;
                 for (mi, m) in p.models.iter().enumerate() {
-                    let col = PALETTE[mi % 2];
+                    let col = model_colour(mi);
                     let (mu, sd) = pick(m);
                     if let Some(sd) = sd {
                         let upper =
