@@ -93,6 +93,18 @@ struct FileIn {
 }
 
 impl PrssmModel {
+    /// The model file's text, compact ([`PrssmModel::from_json`] reads it back).
+    ///
+    /// # Errors
+    /// A parameter that JSON cannot hold (never for a checked model).
+    pub fn to_json(&self) -> Result<String, serde_json::Error> {
+        serde_json::to_string(&FileOut {
+            format: MODEL_FORMAT,
+            version: MODEL_VERSION,
+            model: self,
+        })
+    }
+
     /// Writes the model atomically as pretty JSON.
     ///
     /// # Errors

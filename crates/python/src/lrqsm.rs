@@ -170,4 +170,18 @@ impl Lrqsm {
     fn to_json(&self) -> PyResult<String> {
         serde_json::to_string(&self.model).map_err(|e| PyValueError::new_err(e.to_string()))
     }
+
+    /// A model from the model file's JSON text (`to_json`).
+    #[staticmethod]
+    fn from_json(text: &str) -> PyResult<Self> {
+        LrqsmModel::from_json(text, std::path::Path::new("(JSON text)"))
+            .map(|model| Self { model })
+            .map_err(|e| PyValueError::new_err(e.to_string()))
+    }
+
+    /// Pickling: the model file's text.
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyAny>, (String,))> {
+        let from_json = slf.get_type().getattr("from_json")?;
+        Ok((from_json, (slf.get().to_json()?,)))
+    }
 }

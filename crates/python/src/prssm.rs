@@ -3,8 +3,9 @@
 use std::path::PathBuf;
 
 use flapssm_jobs::JobError;
+use flapssm_jobs::progress::Progress;
 use flapssm_jobs::stream::{LoadStream, StreamSettings};
-use flapssm_jobs::train::{TrainFiles, TrainingOptions, train_dataset};
+use flapssm_jobs::train::{TrainFiles, TrainingOptions, train_dataset, train_prssm};
 use flapssm_prssm::PrssmModel;
 use numpy::{
     PyArray1, PyArray2, PyArray3, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2,
@@ -163,7 +164,23 @@ impl Prssm {
 
     /// The model file's JSON text.
     fn to_json(&self) -> PyResult<String> {
-        serde_json::to_string(&self.model).map_err(|e| PyValueError::new_err(format!("model: {e}")))
+        self.model
+            .to_json()
+            .map_err(|e| PyValueError::new_err(format!("model: {e}")))
+    }
+
+    /// A model from the model file's JSON text (`to_json`).
+    #[staticmethod]
+    fn from_json(text: &str) -> PyResult<Self> {
+        PrssmModel::from_json(text, std::path::Path::new("(JSON text)"))
+            .map(|model| Self { model })
+            .map_err(|e| PyValueError::new_err(e.to_string()))
+    }
+
+    /// Pickling: the model file's text.
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyAny>, (String,))> {
+        let from_json = slf.get_type().getattr("from_json")?;
+        Ok((from_json, (slf.get().to_json()?,)))
     }
 
     fn __repr__(&self) -> String {
@@ -213,7 +230,8 @@ impl Stream {
 /// best model to `out`, the last to `<out>.last.json`, checkpoints to `<out>.ckpt.json` and
 /// the learning curve (one row per evaluated epoch, with wall time) to `<out>.curve.csv`.
 /// Returns the best model. Ctrl-C (or an exception of `progress`) stops at the next step
-/// with a checkpoint; `resume=True` continues from it.
+/// with a checkpoint; `resume=True` continues from it. With `out=None` nothing is written:
+/// the best model is returned from memory (no checkpoint, so no `resume`).
 #[pyfunction]
 #[pyo3(signature = (dataset, out, preset="paper", dx=None, inducing=None, particles=None,
     epochs=None, iterations=None, batch=None, lr=None, seed=0, val_fraction=0.1,
@@ -224,7 +242,7 @@ impl Stream {
 pub fn train(
     py: Python<'_>,
     dataset: &Dataset,
-    out: PathBuf,
+    out: Option<PathBuf>,
     preset: &str,
     dx: Option<usize>,
     inducing: Option<usize>,
@@ -286,6 +304,49 @@ pub fn train(
     }
     .check()
     .map_err(|e| job_error(e, None))?;
+    let Some(out) = out else {
+        if resume {
+            return Err(PyValueError::new_err(
+                "resume=True needs the out path of the interrupted run's checkpoint",
+            ));
+        }
+        if !dataset.inner.has_outputs() {
+            return Err(job_error(
+                flapssm_wing::dataset::DatasetError::NoOutputs.into(),
+                None,
+            ));
+        }
+        let bar = PyProgress::new(progress);
+        let result = py.detach(|| {
+            bar.start("train PR-SSM", 0);
+            let fit = train_prssm(
+                dataset.inner.train(),
+                &plan,
+                None,
+                None,
+                None,
+                &bar,
+                Some(&bar.stop),
+            );
+            if let Ok(f) = &fit {
+                bar.finish(&format!("{} steps", f.outcome.state.step));
+            }
+            fit
+        });
+        let pending = bar.take_error();
+        return match result {
+            Ok(fit) => Ok(Prssm { model: fit.best }),
+            Err(e @ JobError::Interrupted { .. }) => match pending {
+                Some(err) if !err.is_instance_of::<pyo3::exceptions::PyKeyboardInterrupt>(py) => {
+                    Err(err)
+                }
+                _ => Err(pyo3::exceptions::PyKeyboardInterrupt::new_err(
+                    e.to_string(),
+                )),
+            },
+            Err(e) => Err(pending.unwrap_or_else(|| job_error(e, None))),
+        };
+    };
     let files = TrainFiles::beside(&out, None);
     flapssm_jobs::files::check_outputs(
         &[&files.model, &files.last, &files.checkpoint, &files.curve],

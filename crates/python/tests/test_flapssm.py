@@ -141,7 +141,7 @@ def test_keyboard_interrupt_leaves_a_resumable_checkpoint(small, tmp_path, sigin
 def test_start_precision_and_task_size_are_recorded(small, tmp_path):
     model = _tiny(small, tmp_path / "k.json", inducing_init="kmeans", precision="mixed",
                   windows_per_task=1, lengthscale_init=5.0)
-    spec = json.loads(model.to_json())["training"]["spec"]
+    spec = json.loads(model.to_json())["model"]["training"]["spec"]
     assert spec["inducing_init"] == "kmeans" and spec["precision"] == "mixed"
     assert spec["windows_per_task"] == 1 and spec["init"]["lengthscale"] == 5.0
 
@@ -169,22 +169,39 @@ def test_estimators_follow_scikit_learn_conventions(small):
     est = flapssm.LRQSMRegressor(n_folds=3)
     assert est.get_params()["n_folds"] == 3
     assert est.set_params(n_folds=4) is est and est.n_folds == 4
-    with pytest.raises(ValueError, match="invalid parameter"):
+    with pytest.raises(ValueError, match="[Ii]nvalid parameter"):
         est.set_params(bogus=1)
     with pytest.raises(ValueError, match="not fitted"):
         est.predict(small)
-    est.fit(small.inputs, small.outputs, euler_rad=small.euler_rad)
+    # Arrays: the motion (Euler angles) and the loads; the inputs come from the angles.
+    est.fit(small.euler_rad, small.outputs)
     assert est.coef_.shape == (5, 11) and est.lambda_.shape == (5,)
-    pred = est.predict(small.inputs, euler_rad=small.euler_rad)
-    same = flapssm.dataset_from_arrays(small.euler_rad, small.inputs, small.outputs)
+    pred = est.predict(small.euler_rad)
+    u = np.stack([flapssm.kinematics(e, 0.04) for e in small.euler_rad])
+    same = flapssm.dataset_from_arrays(small.euler_rad, u, small.outputs)
     assert np.array_equal(pred, flapssm.LRQSM.fit(same, n_folds=4).predict(same))
+    with pytest.raises(ValueError, match=r"X: Euler angles \(n_trajectories, n_samples, 3\)"):
+        est.predict(small.inputs)
+    with pytest.raises(ValueError, match="requires y"):
+        flapssm.LRQSMRegressor().fit(small.euler_rad)
     clone = type(est)(**est.get_params())
     assert not hasattr(clone, "model_") and clone.get_params() == est.get_params()
-
+    # A Dataset as X carries its own inputs and loads.
     prssm = flapssm.PRSSMRegressor(preset="sysid", dx=5, inducing=8, particles=4, batch=2, epochs=2,
                                    predict_particles=5)
     mean, std = prssm.fit(small).predict(small, return_std=True)
     assert mean.shape == (4, 470, 5) and (std > 0).all() and prssm.n_state_ == 5
+
+
+def test_train_in_memory_writes_nothing(small, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    model = flapssm.train(small, None, "sysid", dx=5, inducing=8, particles=4, batch=2, epochs=2)
+    assert model.n_state == 5 and list(tmp_path.iterdir()) == []
+    same = flapssm.train(small, tmp_path / "m.json", "sysid", dx=5, inducing=8, particles=4, batch=2, epochs=2)
+    a, b = (m.predict_dataset(small, 5, 1)[0] for m in (model, same))
+    assert np.array_equal(a, b), "in memory and through files: the same model"
+    with pytest.raises(ValueError, match="resume"):
+        flapssm.train(small, None, "sysid", resume=True)
 
 
 def test_evaluate_returns_the_metrics(small, tmp_path):

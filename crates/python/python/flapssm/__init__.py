@@ -164,7 +164,7 @@ def sysid(
 
 def train(
     dataset: "_native.Dataset",
-    out: PathLike,
+    out: Optional[PathLike] = None,
     preset: str = "paper",
     *,
     dx: Optional[int] = None,
@@ -191,7 +191,8 @@ def train(
     the best model to ``out``, the last to ``<out>.last.json``, checkpoints to
     ``<out>.ckpt.json`` and the learning curve to ``<out>.curve.csv``. Ctrl-C raises
     ``KeyboardInterrupt`` after a checkpoint; ``resume=True`` continues from it (a larger
-    budget extends a finished run). ``best_by``: ``"rmse"`` (validation, else training
+    budget extends a finished run). With ``out=None`` nothing is written and the best model
+    is returned from memory (an interruption then loses the run). ``best_by``: ``"rmse"`` (validation, else training
     rollouts) or ``"training-loss"`` (the published code's ``best.ckpt``; with
     ``val_fraction=0``, the published protocol). ``objective``:
     ``"standard"`` (the unbiased ELBO) or ``"published-code"`` (the authors' objective and
@@ -205,7 +206,7 @@ def train(
     Presets: ``"paper"`` (the published run), ``"paper-fast"`` (the paper's model trained for
     time to quality), ``"sysid"`` (Doerr et al.)."""
     return _native.train(
-        dataset, os.fspath(out), preset, dx, inducing, particles, epochs, iterations, batch,
+        dataset, None if out is None else os.fspath(out), preset, dx, inducing, particles, epochs, iterations, batch,
         lr, int(seed), float(val_fraction), int(checkpoint_every), bool(resume), progress,
         best_by, objective, inducing_init, None if patience is None else int(patience),
         precision, None if windows_per_task is None else int(windows_per_task),

@@ -1,39 +1,60 @@
-"""Estimators in scikit-learn's idiom: ``fit(X, y)`` / ``predict(X)``, ``get_params`` /
-``set_params`` (so ``sklearn.base.clone`` works), fitted attributes ending in ``_``, inputs
-validated. ``X``: inputs ``(n, T, 7)`` (see :mod:`flapssm`), ``y``: loads ``(n, T, 5)``; both
-estimators also need the Euler angles for U_ref and the quasi-steady features, given as
-``euler_rad`` ``(n, T, 3)`` to ``fit`` / ``predict`` (or a :class:`flapssm.Dataset` as ``X``).
+"""Load models as scikit-learn estimators, with **trajectories as samples**.
+
+``X`` is the wing's motion and ``y`` its loads, one row per trajectory:
+
+- ``X``: Euler angles ``(n, T, 3)`` [stroke φ, deviation ψ, pitch α] in rad, sampled every
+  ``dt_s`` (the paper's 25 Hz: 0.04 s), or the same flattened to ``(n, 3·T)`` (sample-major:
+  φ₀ ψ₀ α₀ φ₁ …), or a :class:`flapssm.Dataset` (which also carries its own inputs);
+- ``y``: loads ``(n, T, 5)`` [F_x, F_y (N), M_x, M_y, M_z (N·mm)], or flattened ``(n, 5·T)``.
+
+The wing-frame inputs ``u`` (:data:`flapssm.INPUT_NAMES`) are computed from the angles by
+:func:`flapssm.kinematics`, the same in ``fit`` and ``predict``. ``predict`` returns the loads in
+``X``'s layout. Because the samples are trajectories, scikit-learn's tools split, resample and
+cross-validate whole trajectories: ``cross_val_score(est, X, y, groups=g, cv=GroupKFold())``,
+``GridSearchCV``, ``clone`` and ``Pipeline`` work as with any regressor.
+
+With scikit-learn installed the estimators are built on its ``BaseEstimator`` and
+``RegressorMixin`` (``get_params``, ``set_params``, ``clone``, tags); without it, on a small
+stand-in with the same methods, so that ``import flapssm`` never needs scikit-learn.
 """
 
 from __future__ import annotations
 
 import inspect
-import os
-import tempfile
 from typing import Any, Optional
 
 import numpy as np
 
 import flapssm
-from ._arrays import as_float_array
+
+try:  # scikit-learn is optional: its base classes when present.
+    from sklearn.base import BaseEstimator, RegressorMixin
+
+    _SKLEARN = True
+except ImportError:  # pragma: no cover - exercised by the test without scikit-learn
+    _SKLEARN = False
+
+N_ANGLES = 3
+N_LOADS = 5
 
 
 class _Params:
-    """``get_params`` / ``set_params`` from the constructor's keyword arguments."""
+    """``get_params`` / ``set_params`` / ``repr`` from the constructor's keyword arguments,
+    as scikit-learn's ``BaseEstimator`` (used when scikit-learn is not installed)."""
 
     @classmethod
-    def _param_names(cls) -> list:
+    def _get_param_names(cls) -> list:
         sig = inspect.signature(cls.__init__)
         return [p for p in sig.parameters if p != "self"]
 
     def get_params(self, deep: bool = True) -> dict:
-        return {k: getattr(self, k) for k in self._param_names()}
+        return {k: getattr(self, k) for k in self._get_param_names()}
 
     def set_params(self, **params: Any) -> "_Params":
-        names = self._param_names()
+        names = self._get_param_names()
         for k, v in params.items():
             if k not in names:
-                raise ValueError(f"invalid parameter {k!r} for {type(self).__name__}; valid: {names}")
+                raise ValueError(f"invalid parameter {k!r} for estimator {type(self).__name__}; valid: {names}")
             setattr(self, k, v)
         return self
 
@@ -41,58 +62,162 @@ class _Params:
         args = ", ".join(f"{k}={v!r}" for k, v in self.get_params().items())
         return f"{type(self).__name__}({args})"
 
-    def _check_fitted(self, attr: str) -> None:
-        if not hasattr(self, attr):
-            raise ValueError(f"this {type(self).__name__} is not fitted yet: call fit first")
+
+_BASES: tuple = (RegressorMixin, BaseEstimator) if _SKLEARN else (_Params,)
 
 
-def _dataset(X: Any, y: Any, euler_rad: Any, dt_s: float, n_train: Optional[int] = None) -> "flapssm.Dataset":
+def _as_array(a: Any, name: str) -> np.ndarray:
+    """float64 array; with scikit-learn, through its ``check_array`` (its messages for sparse,
+    complex, object, empty and non-finite data)."""
+    if _SKLEARN:
+        from sklearn.utils.validation import check_array
+
+        return check_array(a, dtype=np.float64, allow_nd=True, ensure_2d=False, input_name=name)
+    return np.asarray(a, dtype=np.float64)
+
+
+def _angles(X: Any) -> tuple:
+    """``(euler_rad (n, T, 3), flat)`` from ``X`` in either layout, checked."""
+    a = _as_array(X, "X")
+    if a.ndim == 3 and a.shape[2] == N_ANGLES:
+        out, flat = a, False
+    elif a.ndim == 2 and a.shape[1] % N_ANGLES == 0 and a.shape[1] > 0:
+        out, flat = a.reshape(a.shape[0], a.shape[1] // N_ANGLES, N_ANGLES), True
+    else:
+        raise ValueError(
+            f"X: Euler angles (n_trajectories, n_samples, 3) in rad, or (n_trajectories, 3·n_samples) "
+            f"flattened; got shape {a.shape}"
+        )
+    if out.shape[0] == 0 or out.shape[1] < 2:
+        raise ValueError(f"X: at least one trajectory of at least 2 samples; got {out.shape[:2]}")
+    if not np.isfinite(out).all():
+        raise ValueError("X: the Euler angles hold NaN or infinity")
+    return out, flat
+
+
+def _loads(y: Any, n: int, t: int) -> np.ndarray:
+    a = _as_array(y, "y")
+    if a.shape == (n, t, N_LOADS):
+        return a
+    if a.shape == (n, t * N_LOADS):
+        return a.reshape(n, t, N_LOADS)
+    raise ValueError(
+        f"y: loads (n_trajectories, n_samples, 5) = ({n}, {t}, 5), or ({n}, {5 * t}) flattened; got shape {a.shape}"
+    )
+
+
+def _dataset(est: Any, X: Any, y: Any = None, n_train: Optional[int] = None) -> tuple:
+    """A :class:`flapssm.Dataset` of ``X`` (and ``y``) and whether ``X`` was flattened."""
     if isinstance(X, flapssm.Dataset):
-        return X
-    if euler_rad is None:
-        raise ValueError("euler_rad (n, T, 3) is needed with array inputs (or pass a flapssm.Dataset as X)")
-    return flapssm.dataset_from_arrays(euler_rad, X, y, n_train=n_train, dt_s=dt_s)
+        return X, False
+    if y is None and n_train is None:
+        raise ValueError(f"{type(est).__name__} requires y to be passed, but the target y is None")
+    euler, flat = _angles(X)
+    n, t = euler.shape[:2]
+    u = np.stack([flapssm.kinematics(e, est.dt_s) for e in euler])
+    loads = None if y is None else _loads(y, n, t)
+    return flapssm.dataset_from_arrays(euler, u, loads, n_train=n_train, dt_s=est.dt_s), flat
 
 
-class LRQSMRegressor(_Params):
-    """The LRQSM baseline: elastic net on the quasi-steady features, λ by K-fold CV.
+def _layout(loads: np.ndarray, flat: bool) -> np.ndarray:
+    return loads.reshape(loads.shape[0], -1) if flat else loads
 
-    Fitted attributes: ``model_`` (:class:`flapssm.LRQSM`), ``coef_`` ``(5, n_features)``,
-    ``intercept_`` ``(5,)``, ``lambda_`` ``(5,)``."""
+
+class _LoadRegressor(*_BASES):
+    """What both estimators share: the data contract, ``score`` and the tags."""
+
+    def _check_fitted(self) -> None:
+        if not hasattr(self, "model_"):
+            msg = f"this {type(self).__name__} instance is not fitted yet: call fit first"
+            if _SKLEARN:
+                from sklearn.exceptions import NotFittedError
+
+                raise NotFittedError(msg)
+            raise ValueError(msg)
+
+    def _fitted_shape(self, X: Any) -> None:
+        if isinstance(X, flapssm.Dataset):
+            return
+        euler, _ = _angles(X)
+        self.n_features_in_ = euler.shape[1] * N_ANGLES
+
+    def score(self, X: Any, y: Any = None, sample_weight: Any = None) -> float:
+        """R² of the predicted loads, the mean over the five channels, pooled over the
+        trajectories' samples from ``start_sample`` on (the published evaluation window).
+        ``y``: the loads (or, with a :class:`flapssm.Dataset` as ``X``, its own)."""
+        pred = np.asarray(self.predict(X), dtype=np.float64)
+        if isinstance(X, flapssm.Dataset):
+            true = X.outputs if y is None else np.asarray(y, dtype=np.float64)
+            n, t = X.inputs.shape[:2]
+        else:
+            euler, _ = _angles(X)
+            n, t = euler.shape[:2]
+            true = y
+        true = _loads(true, n, t)[:, self.start_sample:, :].reshape(-1, N_LOADS)
+        pred = pred.reshape(n, t, N_LOADS)[:, self.start_sample:, :].reshape(-1, N_LOADS)
+        w = None
+        if sample_weight is not None:
+            w = np.repeat(np.asarray(sample_weight, dtype=np.float64), t - self.start_sample)
+        mean = np.average(true, axis=0, weights=w)
+        ss_res = np.average((true - pred) ** 2, axis=0, weights=w)
+        ss_tot = np.average((true - mean) ** 2, axis=0, weights=w)
+        return float(np.mean(1.0 - ss_res / np.where(ss_tot > 0, ss_tot, 1.0)))
+
+    def __sklearn_tags__(self):
+        tags = super().__sklearn_tags__()
+        tags.input_tags.three_d_array = True  # (n_trajectories, n_samples, 3) as well as 2-D
+        tags.target_tags.multi_output = True  # five loads per sample
+        tags.target_tags.single_output = False
+        tags.regressor_tags.poor_score = True  # scikit-learn's random data are not a wing's motion
+        return tags
+
+
+class LRQSMRegressor(_LoadRegressor):
+    """The LRQSM baseline (:class:`flapssm.LRQSM`): elastic net on the quasi-steady features,
+    λ by K-fold cross-validation.
+
+    Parameters: ``features`` (``"published"``: the paper's 11), ``l1_ratio`` (default the
+    paper's 0.75), ``n_folds`` (default 10), ``dt_s`` (sampling period of ``X``, s),
+    ``start_sample`` (``score``'s first sample). Fitted attributes: ``model_``, ``coef_``
+    ``(5, n_features)``, ``intercept_`` ``(5,)``, ``lambda_`` ``(5,)``, ``n_features_in_``."""
 
     def __init__(self, features: str = "published", l1_ratio: Optional[float] = None,
-                 n_folds: Optional[int] = None, dt_s: float = 0.04) -> None:
+                 n_folds: Optional[int] = None, dt_s: float = 0.04, start_sample: int = 93) -> None:
         self.features = features
         self.l1_ratio = l1_ratio
         self.n_folds = n_folds
         self.dt_s = dt_s
+        self.start_sample = start_sample
 
-    def fit(self, X: Any, y: Any = None, euler_rad: Any = None) -> "LRQSMRegressor":
-        ds = _dataset(X, y, euler_rad, self.dt_s)
+    def fit(self, X: Any, y: Any = None) -> "LRQSMRegressor":
+        ds, _ = _dataset(self, X, y)
         self.model_ = flapssm.LRQSM.fit(ds, self.features, self.l1_ratio, self.n_folds)
         self.coef_ = self.model_.coef_
         self.intercept_ = self.model_.intercept_
         self.lambda_ = self.model_.lambda_
+        self._fitted_shape(X)
         return self
 
-    def predict(self, X: Any, euler_rad: Any = None) -> np.ndarray:
-        """Loads ``(n, T, 5)`` (N, N·mm)."""
-        self._check_fitted("model_")
-        return self.model_.predict(_dataset(X, None, euler_rad, self.dt_s, n_train=0))
+    def predict(self, X: Any) -> np.ndarray:
+        """Loads (N, N·mm) in ``X``'s layout: ``(n, T, 5)`` or ``(n, 5·T)``."""
+        self._check_fitted()
+        ds, flat = _dataset(self, X, n_train=0)
+        return _layout(self.model_.predict(ds), flat)
 
 
-class PRSSMRegressor(_Params):
-    """The PR-SSM, trained by :func:`flapssm.train` with the CLI's presets and options.
+class PRSSMRegressor(_LoadRegressor):
+    """The PR-SSM (:func:`flapssm.train`) with the CLI's presets and options; trained in
+    memory, nothing written.
 
-    ``predict`` returns the mean loads ``(n, T, 5)``; ``predict(..., return_std=True)`` also
-    their standard deviations. Fitted attributes: ``model_`` (:class:`flapssm.PRSSM`),
-    ``n_state_``. Model files go to ``model_path`` (default: a temporary directory)."""
+    ``predict`` returns the mean loads; ``predict(X, return_std=True)`` also their standard
+    deviations (N, N·mm), by ``predict_particles`` particles with seed ``seed``. Fitted
+    attributes: ``model_`` (:class:`flapssm.PRSSM`), ``n_state_``, ``n_features_in_``."""
 
     def __init__(self, preset: str = "paper", dx: Optional[int] = None, inducing: Optional[int] = None,
                  particles: Optional[int] = None, epochs: Optional[int] = None,
                  iterations: Optional[int] = None, batch: Optional[int] = None, lr: Optional[float] = None,
                  seed: int = 0, val_fraction: float = 0.1, predict_particles: int = 30,
-                 model_path: Optional[str] = None, dt_s: float = 0.04) -> None:
+                 dt_s: float = 0.04, start_sample: int = 93) -> None:
         self.preset = preset
         self.dx = dx
         self.inducing = inducing
@@ -104,25 +229,24 @@ class PRSSMRegressor(_Params):
         self.seed = seed
         self.val_fraction = val_fraction
         self.predict_particles = predict_particles
-        self.model_path = model_path
         self.dt_s = dt_s
+        self.start_sample = start_sample
 
-    def fit(self, X: Any, y: Any = None, euler_rad: Any = None, progress: Any = None) -> "PRSSMRegressor":
-        ds = _dataset(X, y, euler_rad, self.dt_s)
-        path = self.model_path
-        if path is None:
-            self._tmp = tempfile.TemporaryDirectory(prefix="flapssm-")
-            path = os.path.join(self._tmp.name, "prssm.json")
+    def fit(self, X: Any, y: Any = None, progress: Any = None) -> "PRSSMRegressor":
+        """``progress(stage, position, total)``, as :func:`flapssm.train`'s."""
+        ds, _ = _dataset(self, X, y)
         self.model_ = flapssm.train(
-            ds, path, self.preset, dx=self.dx, inducing=self.inducing, particles=self.particles,
+            ds, None, self.preset, dx=self.dx, inducing=self.inducing, particles=self.particles,
             epochs=self.epochs, iterations=self.iterations, batch=self.batch, lr=self.lr,
             seed=self.seed, val_fraction=self.val_fraction, progress=progress,
         )
         self.n_state_ = self.model_.n_state
+        self._fitted_shape(X)
         return self
 
-    def predict(self, X: Any, euler_rad: Any = None, return_std: bool = False) -> Any:
-        self._check_fitted("model_")
-        ds = _dataset(X, None, euler_rad, self.dt_s, n_train=0)
+    def predict(self, X: Any, return_std: bool = False) -> Any:
+        self._check_fitted()
+        ds, flat = _dataset(self, X, n_train=0)
         mean, var, _ = self.model_.predict_dataset(ds, self.predict_particles, self.seed)
-        return (mean, np.sqrt(var)) if return_std else mean
+        mean = _layout(mean, flat)
+        return (mean, _layout(np.sqrt(var), flat)) if return_std else mean
