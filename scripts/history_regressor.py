@@ -1,6 +1,6 @@
 """How much of a wing dataset's loads a flexible regressor learns from the inputs' history.
 
-Issue 27's measure of learnable memory. A regressor is fitted on the training trajectories of a
+The measure of learnable memory of docs/vortex-method.md. A regressor is fitted on the training trajectories of a
 flapssm dataset (``.npz`` of ``flapssm simulate``), from sample 93 on (the published evaluation
 window), once on the instantaneous inputs u_t, once on u_t plus u at ``--lags`` steps back and,
 with ``--ewma``, on u_t plus exponentially weighted moving averages of u (causal, time constants

@@ -1,6 +1,6 @@
 """The spectrum of a wing's loads beyond the quasi-steady ones: do they follow flow time scales?
 
-Issue 27, part 5: a wing's residual against L0 (the quasi-steady loads of the same trajectories)
+A wing's residual against L0 (the quasi-steady loads of the same trajectories)
 should hold the flow's own time scales, the stroke's harmonics and the convective time c/U_ref,
 not bursts faster than any of them. Each DATA.npz is `flapssm simulate --noise-free` of the same
 trajectories at one fidelity; REFERENCE.npz is the same at L0. Per dataset and output channel,

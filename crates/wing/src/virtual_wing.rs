@@ -45,7 +45,7 @@ pub enum Fidelity {
     /// Unsteady low-order ([`crate::aero::unsteady`]).
     L1,
     /// Vortex method strips ([`crate::vortex`]): 2-D vortex sheets per strip with a free
-    /// wake (the default wing until issue 27; chaotic, with LEV bursts).
+    /// wake (chaotic, with LEV bursts; docs/vortex-method.md).
     L2,
     /// Unsteady vortex lattice of the whole plate with a prescribed shed wake
     /// ([`crate::lattice`]): repeatable, not chaotic, no bursts (docs/vortex-method.md).

@@ -157,7 +157,7 @@ fn added_mass_of_a_plate_started_normal_to_itself() {
 /// A long plate (A = 30) pitching about its 15 % chord point, α = 2° sin ωt, at reduced
 /// frequency k = ωc/(2U) = 0.3 while it translates: the normal-force amplitude against
 /// Theodorsen's 2-D |C_L|/α0 = 4.580 (circulatory 4.599 with C(k) = 0.539 − 0.100i … at k 1;
-/// computed with scipy's Hankel functions, docs/vortex-method.md round 13). The lattice's
+/// computed with scipy's Hankel functions). The lattice's
 /// unsteady terms converge as 1/N_c: measured 4.98, 4.79, 4.59 at N_c 4, 8, 16 (k = 1: 8.65,
 /// 7.89, 7.16 against 6.86).
 #[test]
@@ -270,7 +270,7 @@ fn wake_capture(n: usize) -> (f64, f64, f64) {
 }
 
 /// Measurement: wake capture of L3 on the paper's 548 measured trajectories
-/// (docs/vortex-method.md, round 13). `cargo test --release -p flapssm-wing --test lattice
+/// (docs/vortex-method.md, "Current figures"). `cargo test --release -p flapssm-wing --test lattice
 /// l3_wake_capture_study -- --ignored --nocapture`.
 #[test]
 #[ignore = "measurement (a few minutes); reported in docs/vortex-method.md"]

@@ -356,7 +356,7 @@ fn l3_memory_evidence() {
     assert!(ratio > RATIO_PIN_L3, "ratio {ratio}");
 }
 
-/// L2, the default wing until round 14 of docs/vortex-method.md, on the default generator
+/// L2 on the default generator
 /// (measured: L2 QS 0.368, history model 0.316, lag 0.114 cycle; on the hovering generator L0 QS
 /// 0.718, L2 QS 0.408, history 0.407, lag 0.249): the lag target holds; the quasi-steady fit of
 /// L0 and the ratio are pinned at their measured values with a margin (see the module docs).
@@ -451,7 +451,7 @@ fn study_l2_memory_evidence() {
 }
 
 /// The memory figures of the default wing on the paper's measured trajectories (L1, L2, L3,
-/// noise-free, the first 72), for the record (docs/vortex-method.md, round 10). A study, not a
+/// noise-free, the first 72), for the record. A study, not a
 /// check: `cargo test --release -p flapssm-wing --test memory paper_memory_study -- --ignored
 /// --nocapture`.
 #[test]

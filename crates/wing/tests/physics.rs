@@ -501,11 +501,17 @@ fn default_wing_hover_lift() {
     let default = mean_cl(&VirtualWingConfig::default());
     let module = mean_cl(&VirtualWingConfig::ideal());
     eprintln!("flat Robofly hover, L0: mean C_L {default:.3} (default wing), {module:.3} (module)");
-    assert!((1.82..=1.90).contains(&default), "default wing C_L {default}");
-    assert!(module < default && (1.0..=1.8).contains(&module), "module L0 C_L {module}");
+    assert!(
+        (1.82..=1.90).contains(&default),
+        "default wing C_L {default}"
+    );
+    assert!(
+        module < default && (1.0..=1.8).contains(&module),
+        "module L0 C_L {module}"
+    );
 }
 
-/// Hovering figure-of-eight (physics notes §4.4.9, issue 3): the Robofly stroke ±80° at 0.3 Hz
+/// Hovering figure-of-eight (physics notes §4.4.9): the Robofly stroke ±80° at 0.3 Hz
 /// with deviation ψ = −15° sin 2x (tip falling through mid-stroke, rising through the
 /// reversals) and AoA = 45° at mid-stroke, 8 cycles, 500 samples per cycle, at every fidelity.
 /// In every cycle after the first:
@@ -516,7 +522,7 @@ fn default_wing_hover_lift() {
 ///
 /// Measured per-cycle C̄_L: L0 1.700, L1 1.033, L2 1.632–1.645 (docs/virtual-wing.md). L3, the
 /// default wing, gives 0.965, below this band, which is the flat stroke's carried over without a
-/// published figure-of-eight value; it is an open gap of L3 (docs/vortex-method.md, rounds 13
+/// published figure-of-eight value; it is an open gap of L3 (docs/lab/vortex-method-rounds.md, rounds 13
 /// and 14), not loosened here.
 #[test]
 fn hovering_figure_eight_sanity() {
@@ -819,10 +825,9 @@ fn change_in_sd(base: &[[f64; 5]], nudged: &[[f64; 5]]) -> [f64; 5] {
 
 /// The L2 data are a reproducible function of the kinematics: a 0.1 % change of the vortex
 /// core moves no output by more than a quarter of its standard deviation (measured: F_x … M_z
-/// 0.128, 0.049, 0.055, 0.138, 0.150 σ). With the long-lived 2-D wake of round 8 (TEV decay
+/// 0.128, 0.049, 0.055, 0.138, 0.150 σ). With a long-lived 2-D wake (TEV decay
 /// over 40 chords) it moved F_x, M_y and M_z by 0.40–0.44 σ here, about as much as L2 differed
-/// from L0: the wake encounters were chaotic, and no model could learn them from the kinematics
-/// (docs/vortex-method.md, round 9).
+/// from L0: the wake encounters were chaotic, and no model could learn them from the kinematics.
 #[test]
 fn l2_outputs_are_insensitive_to_a_small_parameter_change() {
     let shares = change_in_sd(
@@ -1070,7 +1075,7 @@ fn l2_frozen_wake_is_not_chaotic() {
     }
 }
 
-/// The wake models of docs/vortex-method.md (round 12) side by side: the free wake (default), a
+/// The L2 wake models side by side: the free wake (default), a
 /// frozen wake, and a frozen wake carried down by an induced inflow (w = k·U_ref, or from momentum
 /// theory). Prints the mean C_L of the flat-stroke and the figure-of-eight hover (cycles 2–8),
 /// the r_c0 × 1.001 change, the repeatability in the 2nd and
@@ -1110,12 +1115,12 @@ fn l2_wake_motion_study() {
     }
 }
 
-/// L3 (vortex lattice) on issue 27's criteria, beside nothing else: hover lift on the flat and
-/// the figure-of-eight stroke, the r_c0 × 1.001 change, two histories per cycle, bursts. A
-/// study, not a check: `cargo test --release -p flapssm-wing --test physics l3_study --
+/// L3 (vortex lattice) on the criteria of a rig's loads (docs/vortex-method.md, "Current
+/// figures"): hover lift on the flat and the figure-of-eight stroke, the r_c0 × 1.001 change, two
+/// histories per cycle, bursts. A study, not a check: `cargo test --release -p flapssm-wing --test physics l3_study --
 /// --ignored --nocapture`.
 #[test]
-#[ignore = "study: the L3 vortex lattice on issue 27's criteria"]
+#[ignore = "study: the L3 vortex lattice on the criteria of a rig's loads"]
 fn l3_study() {
     let cfg = VirtualWingConfig {
         fidelity: Fidelity::L3,

@@ -823,8 +823,8 @@ fn wing_l2_hover_stays_in_the_dataset_ranges() {
 
 /// Cycle-mean C_L of the L2 hover in [1.0, 1.8] (physics notes §4.4.9) in every cycle 2–4
 /// (after the impulsive start): 1.54 / 1.69 / 1.69 (mean 1.64); over cycles 2–10 they range
-/// 1.54–1.78 (mean 1.66), against 1.75 at L0 (docs/vortex-method.md, round 8). Before the
-/// strip's profile drag (round 7) the cycles reached 1.82–1.91.
+/// 1.54–1.78 (mean 1.66), against 1.75 at L0. Without the strip's profile drag the cycles reach
+/// 1.82–1.91.
 #[test]
 fn wing_l2_hover_mean_lift_in_band() {
     let (cl, _, _) = l2_hover_coefficients();
@@ -926,11 +926,11 @@ fn study_wing_hover_trace() {
 }
 
 /// Regressions of the r_cp strip over 6 hover cycles.
-/// - Round 5: after a reversal the plate moves back over its last TEV. Placing the new TEV 1/3
+/// - After a reversal the plate moves back over its last TEV. Placing the new TEV 1/3
 ///   of the way towards it put it on the plate (1 − kb → 0), and the Kelvin solve shed runaway
 ///   TEV/LEV pairs (|Γ| ~ 10³ m²/s by cycle 4). With the 1/3 rule used only while the last TEV
 ///   lies behind the TE, the circulations stay physical.
-/// - Round 6: a vortex deleted in the far field (or to make room) took its circulation out of
+/// - A vortex deleted in the far field (or to make room) took its circulation out of
 ///   Kelvin's balance, so the next step shed a TEV/LEV pair 30× the usual size at the plate:
 ///   single-sample spikes of |N'| up to 1441 N/m. Removed vortices now keep their circulation
 ///   at infinity, and a sample's load is the mean over its sub-steps: |N'| stays below 2× the
@@ -1323,7 +1323,7 @@ fn strip_peaks(states: &[EulerState], dt: f64, trace: bool) -> (f64, f64, usize,
 /// Bursts of one L2 strip at r_cp on the first 150 of the paper's measured trajectories: peak
 /// |N'| after the first second above 1.5× the quasi-steady peak + [`BURST_MARGIN_N_M`]; prints
 /// each bursting trajectory, then the solver's diagnostics around the worst one's peak
-/// (docs/vortex-method.md, "Known gaps"). A study: `cargo test --release -p flapssm-wing --test
+/// (docs/vortex-method.md, "Open gaps"). A study: `cargo test --release -p flapssm-wing --test
 /// vortex study_strip_bursts_paper -- --ignored --nocapture` (about 20 s).
 #[test]
 #[ignore = "study: bursts of the L2 strip on the paper's trajectories"]

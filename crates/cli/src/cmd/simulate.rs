@@ -48,7 +48,7 @@ pub struct SimulateArgs {
     #[arg(long)]
     flat: bool,
     /// L2 wake: free (vortex dynamics, the default) or frozen (vortices stay where shed, in
-    /// the moving fluid; docs/vortex-method.md, round 12). Refused at other fidelities.
+    /// the moving fluid; docs/vortex-method.md). Refused at other fidelities.
     #[arg(long, value_name = "MOTION")]
     wake: Option<String>,
     /// Induced inflow of L2 and L3: still, momentum (momentum theory from the recent lift: of

@@ -1,5 +1,5 @@
-//! L3: an unsteady vortex-lattice method (UVLM) of the whole plate with a shed wake, the 3-D
-//! candidate of issue 27 (docs/vortex-method.md, round 13).
+//! L3: an unsteady vortex-lattice method (UVLM) of the whole plate with a shed wake
+//! (docs/vortex-method.md).
 //!
 //! # Model
 //!

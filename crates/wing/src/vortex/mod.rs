@@ -226,7 +226,7 @@ impl std::str::FromStr for WakeMotion {
 /// what a 2-D wake lacks: the downwash and the roll-up into tip and root vortices carry a
 /// hovering wing's wake away within about a half-stroke, so the wing meets the wake of the last
 /// reversal (wake capture) but not an accumulation of older ones. With a long-lived 2-D wake
-/// (40 chords, the default until round 9 of docs/vortex-method.md) the loads were chaotic: a
+/// (40 chords) the loads were chaotic: a
 /// 0.1 % change of the core radius moved F_x by 0.4–0.5 σ.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct LdvmParams {

@@ -23,10 +23,10 @@
 //! more than 4 chords behind it no longer sets its flow). It needs no prior knowledge of the
 //! trajectory and scales with the motion, so coefficients are invariant under time scaling, and
 //! it forgets how the motion began. With `None` it is the mean speed since the start,
-//! (1/t) ∫₀ᵗ |v| dt (before issue 27, part 5): two histories of the same kinematics then kept
+//! (1/t) ∫₀ᵗ |v| dt: two histories of the same kinematics then kept
 //! different LESP thresholds for the whole trajectory, and the chordwise loads of one trajectory
 //! reached through ramp-ins of 0.5 s and 3.72 s still differed by 0.24 σ three cycles later
-//! (0.06 σ with s_U = 4; docs/vortex-method.md, round 11).
+//! (0.06 σ with s_U = 4).
 //!
 //! # Sub-steps
 //!
@@ -65,7 +65,7 @@
 //! theory at C_L 1.6 and the measured median stroke of 128° gives w ≈ 0.23–0.34 U at the two
 //! strips of the default wing. Sections that do not know which way is up (`up_section: None`)
 //! get no inflow. With an inflow the profile drag uses the velocity relative to the moving fluid.
-//! The options are under study, not the default (docs/vortex-method.md, round 12).
+//! The options are for studies, not the default.
 //!
 //! # Profile drag
 //!
