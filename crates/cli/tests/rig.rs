@@ -19,29 +19,68 @@ fn rig_check_writes_its_files_and_refuses_other_trajectories() {
     let dir = tempfile::tempdir().unwrap();
     let ds = dir.path().join("paper.npz");
     ok(&[
-        "simulate", "--source", "paper", "--n", "8", "--noise-free", "--quiet", "--out", s(&ds),
+        "simulate",
+        "--source",
+        "paper",
+        "--n",
+        "8",
+        "--noise-free",
+        "--quiet",
+        "--out",
+        s(&ds),
     ]);
     let out = dir.path().join("rig");
     let text = ok(&[
-        "rig", "check", s(&ds), "--reference", &published(), "--out", s(&out), "--quiet",
+        "rig",
+        "check",
+        s(&ds),
+        "--reference",
+        &published(),
+        "--out",
+        s(&out),
+        "--quiet",
     ]);
-    assert!(text.contains("| r, train |") && text.contains("r(F_y, F_x)"), "{text}");
+    assert!(
+        text.contains("| r, train |") && text.contains("r(F_y, F_x)"),
+        "{text}"
+    );
     let check = json(&out.join("rig-check.json"));
     assert_eq!(check["n_trajectories"], 8);
     assert_eq!(check["fidelity"], "l0");
     assert!(check["test"].is_null());
     assert!(out.join("rig-check.md").exists());
-    assert!(!out.join("rig-examples.png").exists(), "no example trajectory among the first 8");
+    assert!(
+        !out.join("rig-examples.png").exists(),
+        "no example trajectory among the first 8"
+    );
 
     let generated = simulated(dir.path(), 3, 1);
     let bad_out = dir.path().join("bad");
     let o = flapssm(&[
-        "rig", "check", s(&generated), "--reference", &published(), "--out", s(&bad_out), "--quiet",
+        "rig",
+        "check",
+        s(&generated),
+        "--reference",
+        &published(),
+        "--out",
+        s(&bad_out),
+        "--quiet",
     ]);
-    assert_fails(&o, &["trajectory 0", "--source paper"], &bad_out.join("rig-check.json"));
+    assert_fails(
+        &o,
+        &["trajectory 0", "--source paper"],
+        &bad_out.join("rig-check.json"),
+    );
     let missing = dir.path().join("missing.npz");
     let o = flapssm(&[
-        "rig", "check", s(&ds), "--reference", s(&missing), "--out", s(&bad_out), "--quiet",
+        "rig",
+        "check",
+        s(&ds),
+        "--reference",
+        s(&missing),
+        "--out",
+        s(&bad_out),
+        "--quiet",
     ]);
     assert_fails(&o, &["missing.npz"], &bad_out.join("rig-check.json"));
 }
@@ -52,12 +91,33 @@ fn fit_mount_refuses_bad_grids() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("fit.json");
     let o = flapssm(&[
-        "rig", "fit-mount", "--reference", &published(), "--plate-deg", "2:1:1", "--out", s(&out),
+        "rig",
+        "fit-mount",
+        "--reference",
+        &published(),
+        "--plate-deg",
+        "2:1:1",
+        "--out",
+        s(&out),
     ]);
-    assert_eq!(o.status.code(), Some(2), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(
+        o.status.code(),
+        Some(2),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
     let o = flapssm(&[
-        "rig", "fit-mount", "--reference", &published(), "--plate-deg", "40:50:5", "--sensor-deg",
-        "0:0:1", "--out", s(&out), "--quiet",
+        "rig",
+        "fit-mount",
+        "--reference",
+        &published(),
+        "--plate-deg",
+        "40:50:5",
+        "--sensor-deg",
+        "0:0:1",
+        "--out",
+        s(&out),
+        "--quiet",
     ]);
     assert_fails(&o, &["plate_deg", "45"], &out);
 }

@@ -117,7 +117,11 @@ fn the_default_dataset_keeps_the_rigs_chordwise_signature_on_every_seed() {
         let check = rig_check(&ds, &reference, false).unwrap().train;
         let c = check.dataset_couplings;
         assert!(c.fy_fx > 0.6 && c.mx_fx < -0.8, "seed {seed}: {c:?}");
-        assert!(check.channels[1].r > 0.5, "seed {seed}: {:?}", check.channels[1]);
+        assert!(
+            check.channels[1].r > 0.5,
+            "seed {seed}: {:?}",
+            check.channels[1]
+        );
     }
 }
 
