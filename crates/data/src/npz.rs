@@ -53,27 +53,6 @@ pub enum NpzError {
     },
 }
 
-/// Reads a numeric `.npy` file (any numeric dtype, C or Fortran order) as `f64`.
-///
-/// # Errors
-/// [`NpzError::Io`] for an unreadable file, [`NpzError::Malformed`] (the array named by the
-/// file name) for a bad header or payload.
-pub fn read_npy_f64(path: impl AsRef<Path>) -> Result<Array<f64>, NpzError> {
-    let path = path.as_ref();
-    let bytes = std::fs::read(path).map_err(|source| NpzError::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
-    decode_npy_f64(&bytes).map_err(|message| NpzError::Malformed {
-        path: path.to_path_buf(),
-        name: path
-            .file_name()
-            .map(|n| n.to_string_lossy().into_owned())
-            .unwrap_or_default(),
-        message,
-    })
-}
-
 /// Decodes a whole `.npy` byte buffer (any numeric dtype, C or Fortran order) as `f64`.
 ///
 /// # Errors

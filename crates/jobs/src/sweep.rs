@@ -48,15 +48,6 @@ impl SweepKind {
             SweepKind::DataSize => "data-size",
         }
     }
-
-    /// Default values: the paper's D_x {8, 12, 16}; training sizes {64, 128, 256, 512} (a
-    /// doubling series ending at the paper's 512; the paper does not list its sizes).
-    pub fn paper_values(self) -> &'static [usize] {
-        match self {
-            SweepKind::Dx => &[8, 12, 16],
-            SweepKind::DataSize => &[64, 128, 256, 512],
-        }
-    }
 }
 
 impl std::str::FromStr for SweepKind {

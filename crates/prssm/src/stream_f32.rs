@@ -158,31 +158,6 @@ impl StreamPredictorF32 {
         }
     }
 
-    /// Bytes held by the predictor's buffers (the model's parameters in `f32` and the
-    /// per-particle state; the struct itself excluded).
-    pub fn heap_bytes(&self) -> usize {
-        let f32s = self.inv_len.len()
-            + self.zt.len()
-            + self.g_mean.len()
-            + self.q_cov.len()
-            + self.step_var.len()
-            + self.obs_noise_var.len()
-            + self
-                .norm
-                .as_ref()
-                .map_or(0, |n| n.iter().map(Vec::len).sum())
-            + self.x.len()
-            + self.z.len()
-            + self.k.len()
-            + self.wm.len()
-            + self.w2.len()
-            + self.lw.len()
-            + self.u_z.len()
-            + self.out_mean.len()
-            + self.out_var.len();
-        4 * f32s + 8 * self.eps.len()
-    }
-
     /// Reports the moments of `y_t` (mean, variance; `D_y` each) and advances the particles
     /// with `u_t` (`D_u` values, the model's units). Allocates nothing.
     ///

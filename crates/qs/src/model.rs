@@ -127,11 +127,6 @@ impl LrqsmModel {
         self.fit.feature_names.len()
     }
 
-    /// Number of outputs m.
-    pub fn n_outputs(&self) -> usize {
-        self.chosen.len()
-    }
-
     /// Predicts every output for one feature row (length p) into `out` (length m), on the
     /// fitted-target scale, adding the intercept as `mode` says (the model's own choice is
     /// [`prediction_intercept`](Self::prediction_intercept)).

@@ -192,20 +192,6 @@ pub struct PublishedWindow {
     pub last: usize,
 }
 
-impl PublishedWindow {
-    /// The "up" half-stroke of the window, window-relative MATLAB `1:floor(duration/2)`, as an
-    /// absolute 0-based half-open range.
-    pub fn up_range(&self) -> std::ops::Range<usize> {
-        self.first..self.first + self.duration / 2
-    }
-
-    /// The "down" half-stroke, window-relative MATLAB `floor(duration/2):end`, as an absolute
-    /// 0-based half-open range (it shares one sample with the up range, as published).
-    pub fn down_range(&self) -> std::ops::Range<usize> {
-        self.first + self.duration / 2 - 1..self.last + 1
-    }
-}
-
 /// The published one-cycle window (`fplotter.m`) of a sampled stroke angle φ (rad):
 ///
 /// 1. δ = φ\[N−1\] − φ\[N−2\]; among samples 0..N−10, the last 10 with |φ\[i\] − φ\[N−1\]| < |δ|;

@@ -150,16 +150,6 @@ impl SensorConfig {
             ..Self::default()
         }
     }
-
-    /// True when any random effect is on.
-    pub fn is_noisy(&self) -> bool {
-        self.static_residual
-            || self.inertial_residual
-            || self.cross_axis
-            || self.bias_drift
-            || self.vibration
-            || self.white_noise
-    }
 }
 
 /// Per-dataset sensor errors (fixed across trajectories).

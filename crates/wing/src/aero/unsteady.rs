@@ -59,13 +59,6 @@ impl Default for WagnerCoefficients {
     }
 }
 
-impl WagnerCoefficients {
-    /// φ(s).
-    pub fn step_response(&self, s: f64) -> f64 {
-        1.0 - self.a1 * (-self.b1 * s).exp() - self.a2 * (-self.b2 * s).exp()
-    }
-}
-
 /// Settings of the L1 model. Defaults are physically plausible mid-range values
 /// (physics notes §3.1, §3.4).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
