@@ -8,7 +8,7 @@ use flapssm_prssm::train::fit::{FitError, FitOutcome, FitSpec, ObjectiveForm, Pr
 use flapssm_prssm::train::{
     BestBy, Budget, Checkpoint, InducingInit, LrSchedule, TrainEvent, TrainHooks,
 };
-use flapssm_prssm::{Precision, SequenceView};
+use flapssm_prssm::{Precision, PrssmModel, SequenceView};
 use flapssm_wing::dataset::{Trajectory, ValidDataset};
 use serde::{Deserialize, Serialize};
 
@@ -553,6 +553,27 @@ pub fn train_dataset(
         rejected: state.rejected,
         best: state.best.as_ref().map(|b| (b.epoch, b.score)),
     })
+}
+
+/// Trains a PR-SSM on the training trajectories of `ds` as [`train_dataset`] does, but writes
+/// nothing (no model file, checkpoint or learning curve): the best model, in memory. An
+/// interruption loses the run.
+///
+/// # Errors
+/// As [`train_dataset`], without the file errors.
+pub fn train_in_memory(
+    ds: &ValidDataset,
+    plan: &TrainingPlan,
+    progress: &dyn Progress,
+    stop: Option<&AtomicBool>,
+) -> Result<PrssmModel> {
+    if !ds.has_outputs() {
+        return Err(flapssm_wing::dataset::DatasetError::NoOutputs.into());
+    }
+    progress.start("train PR-SSM", 0);
+    let out = train_prssm(ds.train(), plan, None, None, None, progress, stop)?;
+    progress.finish(&format!("{} steps", out.outcome.state.step));
+    Ok(out.best)
 }
 
 #[cfg(test)]

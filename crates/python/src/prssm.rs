@@ -3,9 +3,8 @@
 use std::path::PathBuf;
 
 use flapssm_jobs::JobError;
-use flapssm_jobs::progress::Progress;
 use flapssm_jobs::stream::{LoadStream, StreamSettings};
-use flapssm_jobs::train::{TrainFiles, TrainingOptions, train_dataset, train_prssm};
+use flapssm_jobs::train::{TrainFiles, TrainingOptions, train_dataset, train_in_memory};
 use flapssm_prssm::PrssmModel;
 use numpy::{
     PyArray1, PyArray2, PyArray3, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2,
@@ -310,42 +309,10 @@ pub fn train(
                 "resume=True needs the out path of the interrupted run's checkpoint",
             ));
         }
-        if !dataset.inner.has_outputs() {
-            return Err(job_error(
-                flapssm_wing::dataset::DatasetError::NoOutputs.into(),
-                None,
-            ));
-        }
         let bar = PyProgress::new(progress);
-        let result = py.detach(|| {
-            bar.start("train PR-SSM", 0);
-            let fit = train_prssm(
-                dataset.inner.train(),
-                &plan,
-                None,
-                None,
-                None,
-                &bar,
-                Some(&bar.stop),
-            );
-            if let Ok(f) = &fit {
-                bar.finish(&format!("{} steps", f.outcome.state.step));
-            }
-            fit
-        });
-        let pending = bar.take_error();
-        return match result {
-            Ok(fit) => Ok(Prssm { model: fit.best }),
-            Err(e @ JobError::Interrupted { .. }) => match pending {
-                Some(err) if !err.is_instance_of::<pyo3::exceptions::PyKeyboardInterrupt>(py) => {
-                    Err(err)
-                }
-                _ => Err(pyo3::exceptions::PyKeyboardInterrupt::new_err(
-                    e.to_string(),
-                )),
-            },
-            Err(e) => Err(pending.unwrap_or_else(|| job_error(e, None))),
-        };
+        let result = py.detach(|| train_in_memory(&dataset.inner, &plan, &bar, Some(&bar.stop)));
+        let model = training_result(py, result, bar.take_error(), "")?;
+        return Ok(Prssm { model });
     };
     let files = TrainFiles::beside(&out, None);
     flapssm_jobs::files::check_outputs(
@@ -356,18 +323,34 @@ pub fn train(
     let bar = PyProgress::new(progress);
     let result =
         py.detach(|| train_dataset(&dataset.inner, &plan, &files, resume, &bar, Some(&bar.stop)));
-    let pending = bar.take_error();
+    training_result(
+        py,
+        result,
+        bar.take_error(),
+        "; call train(..., resume=True) to continue",
+    )?;
+    Prssm::load(files.model)
+}
+
+/// A training's outcome as Python sees it: an interruption is `KeyboardInterrupt` (its message
+/// followed by `hint`) unless the progress callback raised something else, which is raised
+/// instead; so is a callback's error behind any other failure.
+fn training_result<T>(
+    py: Python<'_>,
+    result: Result<T, JobError>,
+    pending: Option<PyErr>,
+    hint: &str,
+) -> PyResult<T> {
     match result {
-        Ok(_) => Prssm::load(files.model),
-        Err(e @ JobError::Interrupted { .. }) => {
-            let message = format!("{e}; call train(..., resume=True) to continue");
-            match pending {
-                Some(err) if !err.is_instance_of::<pyo3::exceptions::PyKeyboardInterrupt>(py) => {
-                    Err(err)
-                }
-                _ => Err(pyo3::exceptions::PyKeyboardInterrupt::new_err(message)),
+        Ok(value) => Ok(value),
+        Err(e @ JobError::Interrupted { .. }) => match pending {
+            Some(err) if !err.is_instance_of::<pyo3::exceptions::PyKeyboardInterrupt>(py) => {
+                Err(err)
             }
-        }
+            _ => Err(pyo3::exceptions::PyKeyboardInterrupt::new_err(format!(
+                "{e}{hint}"
+            ))),
+        },
         Err(e) => Err(pending.unwrap_or_else(|| job_error(e, None))),
     }
 }
