@@ -107,16 +107,18 @@ def _loads(y: Any, n: int, t: int) -> np.ndarray:
 
 
 def _dataset(est: Any, X: Any, y: Any = None, n_train: Optional[int] = None) -> tuple:
-    """A :class:`flapssm.Dataset` of ``X`` (and ``y``) and whether ``X`` was flattened."""
+    """A :class:`flapssm.Dataset` of ``X`` (and ``y``), whether ``X`` was flattened, and its
+    number of features (3 per sample; None for a Dataset)."""
     if isinstance(X, flapssm.Dataset):
-        return X, False
+        return X, False, None
     if y is None and n_train is None:
         raise ValueError(f"{type(est).__name__} requires y to be passed, but the target y is None")
     euler, flat = _angles(X)
     n, t = euler.shape[:2]
     u = np.stack([flapssm.kinematics(e, est.dt_s) for e in euler])
     loads = None if y is None else _loads(y, n, t)
-    return flapssm.dataset_from_arrays(euler, u, loads, n_train=n_train, dt_s=est.dt_s), flat
+    ds = flapssm.dataset_from_arrays(euler, u, loads, n_train=n_train, dt_s=est.dt_s)
+    return ds, flat, t * N_ANGLES
 
 
 def _layout(loads: np.ndarray, flat: bool) -> np.ndarray:
@@ -135,25 +137,20 @@ class _LoadRegressor(*_BASES):
                 raise NotFittedError(msg)
             raise ValueError(msg)
 
-    def _fitted_shape(self, X: Any) -> None:
-        if isinstance(X, flapssm.Dataset):
-            return
-        euler, _ = _angles(X)
-        self.n_features_in_ = euler.shape[1] * N_ANGLES
+    def _set_n_features(self, n_features: Optional[int]) -> None:
+        if n_features is not None:
+            self.n_features_in_ = n_features
 
     def score(self, X: Any, y: Any = None, sample_weight: Any = None) -> float:
         """R² of the predicted loads, the mean over the five channels, pooled over the
         trajectories' samples from ``start_sample`` on (the published evaluation window).
         ``y``: the loads (or, with a :class:`flapssm.Dataset` as ``X``, its own)."""
         pred = np.asarray(self.predict(X), dtype=np.float64)
-        if isinstance(X, flapssm.Dataset):
-            true = X.outputs if y is None else np.asarray(y, dtype=np.float64)
-            n, t = X.inputs.shape[:2]
-        else:
-            euler, _ = _angles(X)
-            n, t = euler.shape[:2]
-            true = y
-        true = _loads(true, n, t)[:, self.start_sample:, :].reshape(-1, N_LOADS)
+        n = pred.shape[0]
+        t = pred.size // (n * N_LOADS)
+        if isinstance(X, flapssm.Dataset) and y is None:
+            y = X.outputs
+        true = _loads(y, n, t)[:, self.start_sample:, :].reshape(-1, N_LOADS)
         pred = pred.reshape(n, t, N_LOADS)[:, self.start_sample:, :].reshape(-1, N_LOADS)
         w = None
         if sample_weight is not None:
@@ -190,18 +187,18 @@ class LRQSMRegressor(_LoadRegressor):
         self.start_sample = start_sample
 
     def fit(self, X: Any, y: Any = None) -> "LRQSMRegressor":
-        ds, _ = _dataset(self, X, y)
+        ds, _, n_features = _dataset(self, X, y)
         self.model_ = flapssm.LRQSM.fit(ds, self.features, self.l1_ratio, self.n_folds)
         self.coef_ = self.model_.coef_
         self.intercept_ = self.model_.intercept_
         self.lambda_ = self.model_.lambda_
-        self._fitted_shape(X)
+        self._set_n_features(n_features)
         return self
 
     def predict(self, X: Any) -> np.ndarray:
         """Loads (N, N·mm) in ``X``'s layout: ``(n, T, 5)`` or ``(n, 5·T)``."""
         self._check_fitted()
-        ds, flat = _dataset(self, X, n_train=0)
+        ds, flat, _ = _dataset(self, X, n_train=0)
         return _layout(self.model_.predict(ds), flat)
 
 
@@ -234,19 +231,19 @@ class PRSSMRegressor(_LoadRegressor):
 
     def fit(self, X: Any, y: Any = None, progress: Any = None) -> "PRSSMRegressor":
         """``progress(stage, position, total)``, as :func:`flapssm.train`'s."""
-        ds, _ = _dataset(self, X, y)
+        ds, _, n_features = _dataset(self, X, y)
         self.model_ = flapssm.train(
             ds, None, self.preset, dx=self.dx, inducing=self.inducing, particles=self.particles,
             epochs=self.epochs, iterations=self.iterations, batch=self.batch, lr=self.lr,
             seed=self.seed, val_fraction=self.val_fraction, progress=progress,
         )
         self.n_state_ = self.model_.n_state
-        self._fitted_shape(X)
+        self._set_n_features(n_features)
         return self
 
     def predict(self, X: Any, return_std: bool = False) -> Any:
         self._check_fitted()
-        ds, flat = _dataset(self, X, n_train=0)
+        ds, flat, _ = _dataset(self, X, n_train=0)
         mean, var, _ = self.model_.predict_dataset(ds, self.predict_particles, self.seed)
         mean = _layout(mean, flat)
         return (mean, _layout(np.sqrt(var), flat)) if return_std else mean
