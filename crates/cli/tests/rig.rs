@@ -11,6 +11,20 @@ fn published() -> String {
         .into_owned()
 }
 
+/// `rig check DATASET --reference REFERENCE --out OUT --quiet`.
+fn check_args<'a>(dataset: &'a str, reference: &'a str, out: &'a str) -> [&'a str; 8] {
+    [
+        "rig",
+        "check",
+        dataset,
+        "--reference",
+        reference,
+        "--out",
+        out,
+        "--quiet",
+    ]
+}
+
 /// The check writes its three files for a dataset holding test trajectories #5 and #13 (indices
 /// 516 and 524 need 525 trajectories; the first 8 suffice for the other files) and refuses a
 /// generated dataset, naming it, with no file written.
@@ -30,16 +44,7 @@ fn rig_check_writes_its_files_and_refuses_other_trajectories() {
         s(&ds),
     ]);
     let out = dir.path().join("rig");
-    let text = ok(&[
-        "rig",
-        "check",
-        s(&ds),
-        "--reference",
-        &published(),
-        "--out",
-        s(&out),
-        "--quiet",
-    ]);
+    let text = ok(&check_args(s(&ds), &published(), s(&out)));
     assert!(
         text.contains("| r, train |") && text.contains("r(F_y, F_x)"),
         "{text}"
@@ -56,32 +61,14 @@ fn rig_check_writes_its_files_and_refuses_other_trajectories() {
 
     let generated = simulated(dir.path(), 3, 1);
     let bad_out = dir.path().join("bad");
-    let o = flapssm(&[
-        "rig",
-        "check",
-        s(&generated),
-        "--reference",
-        &published(),
-        "--out",
-        s(&bad_out),
-        "--quiet",
-    ]);
+    let o = flapssm(&check_args(s(&generated), &published(), s(&bad_out)));
     assert_fails(
         &o,
         &["trajectory 0", "--source paper"],
         &bad_out.join("rig-check.json"),
     );
     let missing = dir.path().join("missing.npz");
-    let o = flapssm(&[
-        "rig",
-        "check",
-        s(&ds),
-        "--reference",
-        s(&missing),
-        "--out",
-        s(&bad_out),
-        "--quiet",
-    ]);
+    let o = flapssm(&check_args(s(&ds), s(&missing), s(&bad_out)));
     assert_fails(&o, &["missing.npz"], &bad_out.join("rig-check.json"));
 }
 

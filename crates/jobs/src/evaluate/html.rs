@@ -54,10 +54,15 @@ fn row(label: String, cells: Vec<String>) -> Vec<String> {
     std::iter::once(label).chain(cells).collect()
 }
 
+/// Owned cells from text.
+fn strings(cells: &[&str]) -> Vec<String> {
+    cells.iter().map(|s| s.to_string()).collect()
+}
+
 /// A table header: the first column's name, then `names`.
 fn header(first: &str, names: &[&str]) -> Vec<String> {
     std::iter::once(first.to_string())
-        .chain(names.iter().map(|s| s.to_string()))
+        .chain(strings(names))
         .collect()
 }
 
@@ -179,10 +184,7 @@ fn paper_section(r: &EvaluationReport) -> Option<Section> {
         ],
         tables: vec![Table {
             caption: "Paper vs flapssm".into(),
-            header: ["endpoint", "source", "paper", "flapssm", "flapssm vs paper"]
-                .iter()
-                .map(|s| s.to_string())
-                .collect(),
+            header: strings(&["endpoint", "source", "paper", "flapssm", "flapssm vs paper"]),
             rows: r
                 .paper_comparison
                 .iter()
@@ -318,10 +320,7 @@ fn test_trajectory_table(r: &EvaluationReport) -> (Vec<String>, Vec<Vec<String>>
             cells
         })
         .collect();
-    let mut header: Vec<String> = ["test #", "family", "U_ref (m/s)", "period (samples)"]
-        .iter()
-        .map(|s| s.to_string())
-        .collect();
+    let mut header = strings(&["test #", "family", "U_ref (m/s)", "period (samples)"]);
     for c in ["C_Fx", "C_Fy"] {
         header.extend(r.models.iter().map(|m| format!("{c} {}", m.model)));
     }
@@ -364,13 +363,10 @@ fn authority_section(
         )],
         tables: vec![Table {
             caption: "The pairs the paper reports (Fig. 5)".into(),
-            header: [
+            header: strings(&[
                 "input", "state", "median max |r|", "median lag (cycles)",
                 "lag IQR", "mode lag", "strong (median |r| > 0.5)",
-            ]
-            .iter()
-            .map(|s| s.to_string())
-            .collect(),
+            ]),
             rows,
         }],
         figures: vec![
