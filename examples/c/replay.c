@@ -9,8 +9,8 @@
  * order and units (the wing: AoA rad, |v| m/s, a_x a_y a_z m/s^2, pitch rate rad/s, pitch
  * acceleration rad/s^2). Writes `step,mean_0..,var_0..` rows to stdout (%.17g), like
  * `flapssm predict --inputs`, and the time per step and the stream's size to stderr.
- * --f32: float inputs and outputs on the double-precision stream (flapssm_stream_step_f32);
- * --f32-native: the single-precision stream (flapssm_stream_f32_*).
+ * --f32: float inputs and outputs on the double-precision stream (flapssm_stream_step_f32_arrays);
+ * --f32-native: the single-precision stream (flapssm_single_stream_*).
  * --repeat R replays the trajectory R times (reset between replays) for a steadier timing;
  * only the first replay is printed.
  *
@@ -106,7 +106,7 @@ int main(int argc, char **argv) {
 
     FlapssmModel *model = NULL;
     FlapssmStream *stream = NULL;
-    FlapssmStreamF32 *stream32 = NULL;
+    FlapssmSingleStream *stream32 = NULL;
     if (flapssm_model_load(argv[1], &model) != FLAPSSM_STATUS_OK) return fail("loading the model");
     size_t du = flapssm_model_n_input(model), dy = flapssm_model_n_output(model);
     if (du > MAX_COLUMNS || dy > MAX_COLUMNS) {
@@ -114,7 +114,7 @@ int main(int argc, char **argv) {
         return 1;
     }
     if (single == 2) {
-        if (flapssm_stream_f32_new(model, particles, seed, &stream32) != FLAPSSM_STATUS_OK)
+        if (flapssm_single_stream_new(model, particles, seed, &stream32) != FLAPSSM_STATUS_OK)
             return fail("creating the stream");
     } else if (flapssm_stream_new(model, particles, seed, &stream) != FLAPSSM_STATUS_OK) {
         return fail("creating the stream");
@@ -135,7 +135,7 @@ int main(int argc, char **argv) {
     double t0 = seconds();
     for (long r = 0; r < repeat; r++) {
         if (r > 0) {
-            FlapssmStatus reset = single == 2 ? flapssm_stream_f32_reset(stream32) : flapssm_stream_reset(stream);
+            FlapssmStatus reset = single == 2 ? flapssm_single_stream_reset(stream32) : flapssm_stream_reset(stream);
             if (reset != FLAPSSM_STATUS_OK) return fail("reset");
         }
         for (size_t t = 0; t < rows; t++) {
@@ -143,8 +143,8 @@ int main(int argc, char **argv) {
             FlapssmStatus status;
             if (single) {
                 for (size_t j = 0; j < du; j++) u32[j] = (float)ut[j];
-                status = single == 2 ? flapssm_stream_f32_step(stream32, u32, du, mean32, var32, dy)
-                                     : flapssm_stream_step_f32(stream, u32, du, mean32, var32, dy);
+                status = single == 2 ? flapssm_single_stream_step(stream32, u32, du, mean32, var32, dy)
+                                     : flapssm_stream_step_f32_arrays(stream, u32, du, mean32, var32, dy);
                 for (size_t d = 0; d < dy; d++) {
                     mean[d] = mean32[d];
                     var[d] = var32[d];
@@ -165,7 +165,7 @@ int main(int argc, char **argv) {
             rows, repeat, particles, single == 2 ? "f32 native" : single ? "f32 I/O" : "f64", 1e6 * per_step);
 
     flapssm_stream_free(stream);
-    flapssm_stream_f32_free(stream32);
+    flapssm_single_stream_free(stream32);
     free(u);
     return 0;
 }

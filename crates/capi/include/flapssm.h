@@ -31,13 +31,13 @@ typedef enum FlapssmStatus {
 // A loaded PR-SSM model (opaque; read only once loaded).
 typedef struct FlapssmModel FlapssmModel;
 
+// A single-precision streaming predictor (opaque). Allocated at creation; stepping and
+// resetting allocate nothing.
+typedef struct FlapssmSingleStream FlapssmSingleStream;
+
 // A streaming predictor (opaque). Its buffers are allocated at creation; stepping and
 // resetting allocate nothing.
 typedef struct FlapssmStream FlapssmStream;
-
-// A single-precision streaming predictor (opaque). Allocated at creation; stepping and
-// resetting allocate nothing.
-typedef struct FlapssmStreamF32 FlapssmStreamF32;
 
 #ifdef __cplusplus
 extern "C" {
@@ -79,6 +79,45 @@ size_t flapssm_model_n_output(const struct FlapssmModel *model);
 // `model` is null or a live handle.
 size_t flapssm_model_n_state(const struct FlapssmModel *model);
 
+// Creates a single-precision streaming predictor of `model` (`particles` particles, the
+// draws of `seed`, from `x₀ = 0`: the same draws as [`crate::flapssm_stream_new`]) and
+// stores it in `*out` (to be freed with [`flapssm_single_stream_free`]). The model's
+// factorization is computed in double precision once, then rounded.
+//
+// # Safety
+// `model` is null or a live handle; `out` is null or points to writable storage for a
+// pointer.
+enum FlapssmStatus flapssm_single_stream_new(const struct FlapssmModel *model,
+                                             size_t particles,
+                                             uint64_t seed,
+                                             struct FlapssmSingleStream **out);
+
+// Writes the moments of `y_t` into `mean` and `var` (`n_output` = `D_y` each) and advances
+// the particles with `u_t` (`n_input` = `D_u` values), all in single precision. Allocates
+// nothing. Statuses as [`crate::flapssm_stream_step`].
+//
+// # Safety
+// `stream` is null or a live handle; `u` holds `n_input` readable values and `mean`, `var`
+// `n_output` writable ones (or are null).
+enum FlapssmStatus flapssm_single_stream_step(struct FlapssmSingleStream *stream,
+                                              const float *u,
+                                              size_t n_input,
+                                              float *mean,
+                                              float *var,
+                                              size_t n_output);
+
+// Starts the stream again from `x₀ = 0` with its first draws. Allocates nothing.
+//
+// # Safety
+// `stream` is null or a live handle.
+enum FlapssmStatus flapssm_single_stream_reset(struct FlapssmSingleStream *stream);
+
+// Frees a single-precision stream handle (null is ignored).
+//
+// # Safety
+// `stream` is null or a handle from [`flapssm_single_stream_new`] not freed before.
+void flapssm_single_stream_free(struct FlapssmSingleStream *stream);
+
 // The message of the last failed call on this thread (UTF-8, NUL-terminated; empty when
 // none failed). Valid until the next failing call on this thread; never null.
 const char *flapssm_last_error(void);
@@ -119,12 +158,12 @@ enum FlapssmStatus flapssm_stream_step(struct FlapssmStream *stream,
 //
 // # Safety
 // As [`flapssm_stream_step`], with `float` arrays.
-enum FlapssmStatus flapssm_stream_step_f32(struct FlapssmStream *stream,
-                                           const float *u,
-                                           size_t n_input,
-                                           float *mean,
-                                           float *var,
-                                           size_t n_output);
+enum FlapssmStatus flapssm_stream_step_f32_arrays(struct FlapssmStream *stream,
+                                                  const float *u,
+                                                  size_t n_input,
+                                                  float *mean,
+                                                  float *var,
+                                                  size_t n_output);
 
 // Starts the stream again from `x₀ = 0` with its first draws: the next steps repeat those
 // since creation exactly. Allocates nothing.
@@ -138,45 +177,6 @@ enum FlapssmStatus flapssm_stream_reset(struct FlapssmStream *stream);
 // # Safety
 // `stream` is null or a handle from [`flapssm_stream_new`] not freed before.
 void flapssm_stream_free(struct FlapssmStream *stream);
-
-// Creates a single-precision streaming predictor of `model` (`particles` particles, the
-// draws of `seed`, from `x₀ = 0`: the same draws as [`crate::flapssm_stream_new`]) and
-// stores it in `*out` (to be freed with [`flapssm_stream_f32_free`]). The model's
-// factorization is computed in double precision once, then rounded.
-//
-// # Safety
-// `model` is null or a live handle; `out` is null or points to writable storage for a
-// pointer.
-enum FlapssmStatus flapssm_stream_f32_new(const struct FlapssmModel *model,
-                                          size_t particles,
-                                          uint64_t seed,
-                                          struct FlapssmStreamF32 **out);
-
-// Writes the moments of `y_t` into `mean` and `var` (`n_output` = `D_y` each) and advances
-// the particles with `u_t` (`n_input` = `D_u` values), all in single precision. Allocates
-// nothing. Statuses as [`crate::flapssm_stream_step`].
-//
-// # Safety
-// `stream` is null or a live handle; `u` holds `n_input` readable values and `mean`, `var`
-// `n_output` writable ones (or are null).
-enum FlapssmStatus flapssm_stream_f32_step(struct FlapssmStreamF32 *stream,
-                                           const float *u,
-                                           size_t n_input,
-                                           float *mean,
-                                           float *var,
-                                           size_t n_output);
-
-// Starts the stream again from `x₀ = 0` with its first draws. Allocates nothing.
-//
-// # Safety
-// `stream` is null or a live handle.
-enum FlapssmStatus flapssm_stream_f32_reset(struct FlapssmStreamF32 *stream);
-
-// Frees a single-precision stream handle (null is ignored).
-//
-// # Safety
-// `stream` is null or a handle from [`flapssm_stream_f32_new`] not freed before.
-void flapssm_stream_f32_free(struct FlapssmStreamF32 *stream);
 
 #ifdef __cplusplus
 }  // extern "C"

@@ -26,11 +26,11 @@
 //! - Every call returns a [`FlapssmStatus`]; on an error, [`flapssm_last_error`] gives the
 //!   message (per thread). No call panics across the boundary (a Rust panic becomes
 //!   `FLAPSSM_STATUS_PANIC`).
-//! - Creation allocates; [`flapssm_stream_step`], [`flapssm_stream_step_f32`] and
+//! - Creation allocates; [`flapssm_stream_step`], [`flapssm_stream_step_f32_arrays`] and
 //!   [`flapssm_stream_reset`] allocate nothing.
-//! - Two single-precision paths: [`flapssm_stream_step_f32`] converts at the boundary of a
+//! - Two single-precision paths: [`flapssm_stream_step_f32_arrays`] converts at the boundary of a
 //!   double-precision stream (its outputs are the double step's rounded to `float`), and
-//!   [`FlapssmStreamF32`] (`flapssm_stream_f32_*`) runs the particles, the kernel and the
+//!   [`FlapssmSingleStream`] (`flapssm_single_stream_*`) runs the particles, the kernel and the
 //!   products in `float` (half the memory; for FPUs without fast double precision), with the
 //!   same draws.
 //!
@@ -40,20 +40,20 @@
 #![warn(missing_docs)]
 
 mod model;
+mod single_stream;
 mod status;
 mod stream;
-mod stream_f32;
 
 pub use model::{
     FlapssmModel, flapssm_model_free, flapssm_model_load, flapssm_model_n_input,
     flapssm_model_n_output, flapssm_model_n_state,
 };
+pub use single_stream::{
+    FlapssmSingleStream, flapssm_single_stream_free, flapssm_single_stream_new,
+    flapssm_single_stream_reset, flapssm_single_stream_step,
+};
 pub use status::{FlapssmStatus, flapssm_last_error};
 pub use stream::{
     FlapssmStream, flapssm_stream_free, flapssm_stream_new, flapssm_stream_reset,
-    flapssm_stream_step, flapssm_stream_step_f32,
-};
-pub use stream_f32::{
-    FlapssmStreamF32, flapssm_stream_f32_free, flapssm_stream_f32_new, flapssm_stream_f32_reset,
-    flapssm_stream_f32_step,
+    flapssm_stream_step, flapssm_stream_step_f32_arrays,
 };

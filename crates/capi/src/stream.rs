@@ -166,6 +166,57 @@ pub(crate) unsafe fn with_arrays<H: Handle, T>(
     })
 }
 
+/// A handle whose stream steps in the precision of the caller's arrays.
+pub(crate) trait SamePrecisionStep<T>: Handle {
+    /// Why a step failed.
+    type Error: std::fmt::Display;
+    /// The moments of `y_t` (`D_y` each), then the particles advanced with `u` (`D_u`).
+    fn step(&mut self, u: &[T]) -> Result<(&[T], &[T]), Self::Error>;
+}
+
+impl SamePrecisionStep<f64> for FlapssmStream {
+    type Error = JobError;
+    fn step(&mut self, u: &[f64]) -> Result<(&[f64], &[f64]), JobError> {
+        self.stream.step(u)
+    }
+}
+
+/// A step whose arrays are in the stream's own precision: the handle, pointers, lengths and
+/// input checked ([`with_arrays`], [`checked_step`]), the step run, the moments copied out.
+///
+/// # Safety
+/// As [`flapssm_stream_step`].
+pub(crate) unsafe fn step_same_precision<H: SamePrecisionStep<T>, T: Copy + Into<f64>>(
+    stream: *mut H,
+    u: *const T,
+    n_input: usize,
+    mean: *mut T,
+    var: *mut T,
+    n_output: usize,
+) -> FlapssmStatus {
+    // SAFETY: forwarded caller contract.
+    unsafe {
+        with_arrays(
+            stream,
+            u,
+            n_input,
+            mean,
+            var,
+            n_output,
+            |s, u, mean, var| {
+                checked_step(
+                    u,
+                    |u| s.step(u),
+                    |m, v| {
+                        mean.copy_from_slice(m);
+                        var.copy_from_slice(v);
+                    },
+                )
+            },
+        )
+    }
+}
+
 /// Writes the moments of `y_t` into `mean` and `var` (`n_output` = `D_y` each) and advances
 /// the particles with the input `u_t` (`n_input` = `D_u` values). Allocates nothing.
 ///
@@ -185,26 +236,7 @@ pub unsafe extern "C" fn flapssm_stream_step(
     n_output: usize,
 ) -> FlapssmStatus {
     // SAFETY: forwarded caller contract.
-    unsafe {
-        with_arrays(
-            stream,
-            u,
-            n_input,
-            mean,
-            var,
-            n_output,
-            |s, u, mean, var| {
-                checked_step(
-                    u,
-                    |u| s.stream.step(u),
-                    |m, v| {
-                        mean.copy_from_slice(m);
-                        var.copy_from_slice(v);
-                    },
-                )
-            },
-        )
-    }
+    unsafe { step_same_precision(stream, u, n_input, mean, var, n_output) }
 }
 
 /// [`flapssm_stream_step`] in single precision: the inputs are widened to `double`, the step
@@ -213,7 +245,7 @@ pub unsafe extern "C" fn flapssm_stream_step(
 /// # Safety
 /// As [`flapssm_stream_step`], with `float` arrays.
 #[unsafe(no_mangle)]
-pub unsafe extern "C" fn flapssm_stream_step_f32(
+pub unsafe extern "C" fn flapssm_stream_step_f32_arrays(
     stream: *mut FlapssmStream,
     u: *const f32,
     n_input: usize,

@@ -147,14 +147,14 @@ fn errors_are_statuses_with_messages() {
     );
     let mut stream32 = null_mut();
     assert_eq!(
-        unsafe { flapssm_stream_f32_new(null(), 30, 0, &mut stream32) },
+        unsafe { flapssm_single_stream_new(null(), 30, 0, &mut stream32) },
         FlapssmStatus::NullArgument
     );
     let u32 = [0.1f32; 7];
     let (mut m32, mut v32) = ([0.0f32; 5], [0.0f32; 5]);
     assert_eq!(
         unsafe {
-            flapssm_stream_f32_step(
+            flapssm_single_stream_step(
                 null_mut(),
                 u32.as_ptr(),
                 7,
@@ -166,7 +166,7 @@ fn errors_are_statuses_with_messages() {
         FlapssmStatus::NullArgument
     );
     assert_eq!(
-        unsafe { flapssm_stream_f32_reset(null_mut()) },
+        unsafe { flapssm_single_stream_reset(null_mut()) },
         FlapssmStatus::NullArgument
     );
     unsafe {
@@ -197,7 +197,7 @@ fn stepping_allocates_nothing_and_the_footprint_is_measured() {
         let live = LIVE.load(Ordering::SeqCst);
         let mut stream32 = null_mut();
         assert_eq!(
-            unsafe { flapssm_stream_f32_new(model, particles, 0, &mut stream32) },
+            unsafe { flapssm_single_stream_new(model, particles, 0, &mut stream32) },
             FlapssmStatus::Ok
         );
         let footprint32 = LIVE.load(Ordering::SeqCst) - live;
@@ -216,7 +216,7 @@ fn stepping_allocates_nothing_and_the_footprint_is_measured() {
                     5,
                 );
                 assert_eq!(s, FlapssmStatus::Ok);
-                let s = flapssm_stream_step_f32(
+                let s = flapssm_stream_step_f32_arrays(
                     stream,
                     ut32.as_ptr(),
                     DU,
@@ -225,7 +225,7 @@ fn stepping_allocates_nothing_and_the_footprint_is_measured() {
                     5,
                 );
                 assert_eq!(s, FlapssmStatus::Ok);
-                let s = flapssm_stream_f32_step(
+                let s = flapssm_single_stream_step(
                     stream32,
                     ut32.as_ptr(),
                     DU,
@@ -235,7 +235,7 @@ fn stepping_allocates_nothing_and_the_footprint_is_measured() {
                 );
                 assert_eq!(s, FlapssmStatus::Ok);
                 assert_eq!(flapssm_stream_reset(stream), FlapssmStatus::Ok);
-                assert_eq!(flapssm_stream_f32_reset(stream32), FlapssmStatus::Ok);
+                assert_eq!(flapssm_single_stream_reset(stream32), FlapssmStatus::Ok);
             }
         }
         assert_eq!(
@@ -245,7 +245,7 @@ fn stepping_allocates_nothing_and_the_footprint_is_measured() {
         );
         unsafe {
             flapssm_stream_free(stream);
-            flapssm_stream_f32_free(stream32);
+            flapssm_single_stream_free(stream32);
         }
         let first = if footprint > 32 << 20 {
             " (the first on this thread: with the GEMM buffer)"

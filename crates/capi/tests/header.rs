@@ -17,7 +17,7 @@ fn the_committed_header_is_generated_from_the_sources() {
     let generated = String::from_utf8(generated).unwrap();
     for name in [
         "flapssm_model_load",
-        "flapssm_stream_step_f32",
+        "flapssm_stream_step_f32_arrays",
         "flapssm_last_error",
         "FLAPSSM_STATUS_SHAPE",
     ] {

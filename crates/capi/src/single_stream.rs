@@ -6,17 +6,25 @@ use flapssm_prssm::stream_f32::StreamPredictorF32;
 
 use crate::model::FlapssmModel;
 use crate::status::{FlapssmStatus, fail, guard};
-use crate::stream::{Handle, checked_step, free_handle, reset_handle, with_arrays};
+use crate::stream::{Handle, SamePrecisionStep, free_handle, reset_handle, step_same_precision};
+use flapssm_prssm::ObjectiveError;
 
 /// A single-precision streaming predictor (opaque). Allocated at creation; stepping and
 /// resetting allocate nothing.
 #[derive(Debug)]
-pub struct FlapssmStreamF32 {
+pub struct FlapssmSingleStream {
     stream: StreamPredictorF32,
     dims: (usize, usize),
 }
 
-impl Handle for FlapssmStreamF32 {
+impl SamePrecisionStep<f32> for FlapssmSingleStream {
+    type Error = ObjectiveError;
+    fn step(&mut self, u: &[f32]) -> Result<(&[f32], &[f32]), ObjectiveError> {
+        self.stream.step(u)
+    }
+}
+
+impl Handle for FlapssmSingleStream {
     fn dims(&self) -> (usize, usize) {
         self.dims
     }
@@ -27,31 +35,31 @@ impl Handle for FlapssmStreamF32 {
 
 /// Creates a single-precision streaming predictor of `model` (`particles` particles, the
 /// draws of `seed`, from `x₀ = 0`: the same draws as [`crate::flapssm_stream_new`]) and
-/// stores it in `*out` (to be freed with [`flapssm_stream_f32_free`]). The model's
+/// stores it in `*out` (to be freed with [`flapssm_single_stream_free`]). The model's
 /// factorization is computed in double precision once, then rounded.
 ///
 /// # Safety
 /// `model` is null or a live handle; `out` is null or points to writable storage for a
 /// pointer.
 #[unsafe(no_mangle)]
-pub unsafe extern "C" fn flapssm_stream_f32_new(
+pub unsafe extern "C" fn flapssm_single_stream_new(
     model: *const FlapssmModel,
     particles: usize,
     seed: u64,
-    out: *mut *mut FlapssmStreamF32,
+    out: *mut *mut FlapssmSingleStream,
 ) -> FlapssmStatus {
     guard(|| {
         // SAFETY: null or live, by the caller's contract.
         let Some(model) = (unsafe { model.as_ref() }) else {
             return fail(
                 FlapssmStatus::NullArgument,
-                "flapssm_stream_f32_new: null model",
+                "flapssm_single_stream_new: null model",
             );
         };
         if out.is_null() {
             return fail(
                 FlapssmStatus::NullArgument,
-                "flapssm_stream_f32_new: null out",
+                "flapssm_single_stream_new: null out",
             );
         }
         let m = &model.model;
@@ -67,7 +75,7 @@ pub unsafe extern "C" fn flapssm_stream_f32_new(
         match StreamPredictorF32::new(m, particles, prediction_seed(seed, 0)) {
             Ok(stream) => {
                 let dims = (m.config.n_input, m.config.n_output);
-                let handle = Box::into_raw(Box::new(FlapssmStreamF32 { stream, dims }));
+                let handle = Box::into_raw(Box::new(FlapssmSingleStream { stream, dims }));
                 // SAFETY: non-null and writable by the caller's contract.
                 unsafe { *out = handle };
                 FlapssmStatus::Ok
@@ -85,8 +93,8 @@ pub unsafe extern "C" fn flapssm_stream_f32_new(
 /// `stream` is null or a live handle; `u` holds `n_input` readable values and `mean`, `var`
 /// `n_output` writable ones (or are null).
 #[unsafe(no_mangle)]
-pub unsafe extern "C" fn flapssm_stream_f32_step(
-    stream: *mut FlapssmStreamF32,
+pub unsafe extern "C" fn flapssm_single_stream_step(
+    stream: *mut FlapssmSingleStream,
     u: *const f32,
     n_input: usize,
     mean: *mut f32,
@@ -94,26 +102,7 @@ pub unsafe extern "C" fn flapssm_stream_f32_step(
     n_output: usize,
 ) -> FlapssmStatus {
     // SAFETY: forwarded caller contract.
-    unsafe {
-        with_arrays(
-            stream,
-            u,
-            n_input,
-            mean,
-            var,
-            n_output,
-            |s, u, mean, var| {
-                checked_step(
-                    u,
-                    |u| s.stream.step(u),
-                    |m, v| {
-                        mean.copy_from_slice(m);
-                        var.copy_from_slice(v);
-                    },
-                )
-            },
-        )
-    }
+    unsafe { step_same_precision(stream, u, n_input, mean, var, n_output) }
 }
 
 /// Starts the stream again from `x₀ = 0` with its first draws. Allocates nothing.
@@ -121,17 +110,19 @@ pub unsafe extern "C" fn flapssm_stream_f32_step(
 /// # Safety
 /// `stream` is null or a live handle.
 #[unsafe(no_mangle)]
-pub unsafe extern "C" fn flapssm_stream_f32_reset(stream: *mut FlapssmStreamF32) -> FlapssmStatus {
+pub unsafe extern "C" fn flapssm_single_stream_reset(
+    stream: *mut FlapssmSingleStream,
+) -> FlapssmStatus {
     // SAFETY: forwarded caller contract.
-    unsafe { reset_handle(stream, "flapssm_stream_f32_reset") }
+    unsafe { reset_handle(stream, "flapssm_single_stream_reset") }
 }
 
 /// Frees a single-precision stream handle (null is ignored).
 ///
 /// # Safety
-/// `stream` is null or a handle from [`flapssm_stream_f32_new`] not freed before.
+/// `stream` is null or a handle from [`flapssm_single_stream_new`] not freed before.
 #[unsafe(no_mangle)]
-pub unsafe extern "C" fn flapssm_stream_f32_free(stream: *mut FlapssmStreamF32) {
+pub unsafe extern "C" fn flapssm_single_stream_free(stream: *mut FlapssmSingleStream) {
     // SAFETY: forwarded caller contract.
     unsafe { free_handle(stream) }
 }
