@@ -11,6 +11,7 @@
 //! | [`xcorr`] | MATLAB `crosscorr`, peak |r| within one cycle | `plotter.m` |
 //! | [`kde`] | 2-D reflected Gaussian KDE, mode, 70 % HDR, contours | `ksdensity` |
 //! | [`authority`] | control-authority analysis (Fig. 5 as data, JSON/CSV) | `plotter.m` |
+//! | [`scores`] | RMSE and Gaussian NLL of a sequence prediction, per-output RMSE, mean ± std over seeds (the sysid protocol) | Doerr et al. (2018) |
 //! | [`rig`] | a dataset's loads against a reference of the rig's (r, z-RMSE, 95 % band, couplings, Fig. 5 lags) | — |
 //! | [`plots`] | PNG/SVG figures (Figs. 2C, 3, 4, 5, training curves) | — |
 //! | [`report`] | one self-contained HTML page | — |
@@ -30,6 +31,7 @@ pub mod metrics;
 pub mod plots;
 pub mod report;
 pub mod rig;
+pub mod scores;
 pub mod stats;
 pub mod xcorr;
 

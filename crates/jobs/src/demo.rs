@@ -31,6 +31,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::curve::CurveRecorder;
 use crate::error::{JobError, Result};
+use crate::evaluate::paper::ComparisonRow;
 use crate::evaluate::{
     AuthorityFinding, EvalOptions, EvaluationReport, METRICS_VERSION, ReportContext, evaluate,
     versions,
@@ -39,7 +40,6 @@ use crate::files::{load_json, save_json};
 use crate::models::lrqsm::LrqsmLoadModel;
 use crate::models::prssm::PrssmLoadModel;
 use crate::models::{BASELINES, Baseline, LoadModel, baseline};
-use crate::paper_comparison::ComparisonRow;
 use crate::progress::Progress;
 use crate::rig::{
     RIG_FILES, RigCheck, RigSettings, load_reference_model, rig_check, rig_reference,
@@ -264,7 +264,7 @@ pub struct DemoSummary {
     /// Output names.
     pub outputs: Vec<String>,
     /// The headline: every endpoint of the paper beside this run's
-    /// ([`crate::paper_comparison`]).
+    /// ([`crate::evaluate::paper`]).
     #[serde(default)]
     pub paper_comparison: Vec<ComparisonRow>,
     /// PR-SSM test RMSE per output (σ units).

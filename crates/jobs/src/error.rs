@@ -44,6 +44,9 @@ pub enum JobError {
     /// The LRQSM failed (fit, prediction or model file).
     #[error("LRQSM: {0}")]
     Qs(#[from] QsError),
+    /// The ARX baseline failed (settings, fit or prediction).
+    #[error(transparent)]
+    Arx(#[from] flapssm_qs::arx::ArxError),
     /// PR-SSM training or prediction failed.
     #[error("PR-SSM {what}: {source}")]
     Prssm {

@@ -26,6 +26,7 @@
 //! (atomic JSON and text files), [`threads`] (the pool a job runs on).
 #![warn(missing_docs)]
 
+pub mod adapters;
 pub mod bench;
 pub mod curve;
 pub mod demo;
@@ -34,7 +35,6 @@ pub mod evaluate;
 pub mod files;
 pub mod kinematics_compare;
 pub mod models;
-pub mod paper_comparison;
 pub mod predict;
 pub mod progress;
 pub mod resources;

@@ -30,7 +30,7 @@ use flapssm_wing::virtual_wing::{Fidelity, VirtualWingConfig, simulate_angles_da
 use serde::{Deserialize, Serialize};
 
 use crate::error::{JobError, Result, analysis};
-use crate::evaluate::INPUT_LABELS;
+use crate::evaluate::report::INPUT_LABELS;
 use crate::predict::predict_prssm;
 use crate::progress::Progress;
 
@@ -408,7 +408,7 @@ fn agreement(
 /// The paper's six example test trajectories (Fig. 3) as dataset indices, where the dataset
 /// holds them: test trajectory #k is index 511 + k.
 pub fn example_indices(n_trajectories: usize) -> Vec<(usize, usize)> {
-    crate::paper_comparison::FIG3_TEST_NUMBERS
+    crate::evaluate::paper::FIG3_TEST_NUMBERS
         .iter()
         .map(|&k| (k, PAPER_N_TRAIN - 1 + k))
         .filter(|&(_, i)| i < n_trajectories)

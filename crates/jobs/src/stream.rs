@@ -16,11 +16,9 @@ use flapssm_data::table::{is_number_row, split_csv_line};
 use flapssm_prssm::PrssmModel;
 use flapssm_prssm::predict::{write_csv_header, write_csv_row};
 use flapssm_prssm::stream::StreamPredictor;
-use flapssm_prssm::train::InitialStateSpec;
-use flapssm_prssm::train::fit::training_record;
 
+use crate::adapters::{input_columns, inputs_only_notes};
 use crate::error::{JobError, Result};
-use crate::predict::input_columns;
 use crate::seed::prediction_seed;
 
 /// Settings of a stream.
@@ -119,22 +117,6 @@ impl LoadStream {
             source: e.into(),
         })
     }
-}
-
-/// Why a model's initial-state rule cannot be applied from inputs alone, if it cannot.
-pub fn inputs_only_notes(model: &PrssmModel) -> Vec<String> {
-    let Ok(record) = training_record(model) else {
-        return Vec::new();
-    };
-    let rule = match record.initial_state.spec {
-        InitialStateSpec::Zeros => return Vec::new(),
-        InitialStateSpec::Outputs => "outputs",
-        _ => "recognition",
-    };
-    vec![format!(
-        "the model was trained with the '{rule}' initial-state rule, which needs the first \
-         outputs; inputs alone are predicted from x_0 = 0 (predict a dataset to apply it)"
-    )]
 }
 
 /// Streams a CSV: a header line of `D_u` column names (matched to the model's inputs by

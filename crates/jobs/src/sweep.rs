@@ -18,9 +18,9 @@ use flapssm_wing::dataset::{OUTPUT_NAMES, Standardization, ValidDataset};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{JobError, Result};
+use crate::evaluate::paper::{ComparisonRow, SelectionPoint, selection_rows};
 use crate::evaluate::prepared::pooled_errors;
 use crate::files::save_json;
-use crate::paper_comparison::{ComparisonRow, SelectionPoint, selection_rows};
 use crate::predict::predict_prssm;
 use crate::progress::Progress;
 use crate::train::{TrainingOptions, TrainingPlan, load_checkpoint, train_prssm};
@@ -409,7 +409,7 @@ pub struct SweepTable {
     #[serde(default)]
     pub selection: Vec<(SweepKind, SelectionPoint)>,
     /// The paper's two selections beside these results
-    /// ([`crate::paper_comparison::selection_rows`]).
+    /// ([`crate::evaluate::paper::selection_rows`]).
     #[serde(default)]
     pub paper_comparison: Vec<ComparisonRow>,
 }

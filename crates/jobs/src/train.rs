@@ -12,9 +12,9 @@ use flapssm_prssm::{Precision, PrssmModel, SequenceView};
 use flapssm_wing::dataset::{Trajectory, ValidDataset};
 use serde::{Deserialize, Serialize};
 
+use crate::adapters::trajectory_sequence;
 use crate::curve::CurveRecorder;
 use crate::error::{JobError, Result};
-use crate::predict::trajectory_sequence;
 use crate::progress::Progress;
 
 /// PR-SSM training settings shared by the sweeps and the demo: a preset with overrides.

@@ -26,7 +26,9 @@
 //!   ([`predict::Prediction`]); [`predict::StepPredictor`]: one step at a time on caller
 //!   buffers, no allocation per step.
 //! - [`PrssmModel`]: config + params + normalization + training settings; JSON file
-//!   ([`PrssmModel::save`], [`PrssmModel::load`]); [`published::import_published`].
+//!   ([`PrssmModel::save`], [`PrssmModel::load`]); [`published::import_published`]; prediction
+//!   in physical units from the model's initial-state rule ([`PrssmModel::predict_sequence`],
+//!   over [`predict::predict_standardized`]; [`Normalization::of_sequences`] for the statistics).
 #![warn(missing_docs)]
 
 pub mod conditional;
@@ -43,7 +45,6 @@ pub mod predict;
 pub mod published;
 pub mod stream;
 pub mod stream_f32;
-pub mod systems;
 mod tape;
 pub mod train;
 

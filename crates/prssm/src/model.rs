@@ -3,9 +3,11 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::elbo::{Sequence, SequenceView};
 use crate::objective::ObjectiveError;
 use crate::params::{ConfigError, ModelConfig, Params};
-use crate::predict::{self, Prediction};
+use crate::predict::{self, Prediction, PredictionError};
+use crate::train::initial::{InitialStateModel, InitialStateSpec};
 
 /// Per-channel affine normalization `z = (v − mean) / std` of inputs and outputs.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -57,6 +59,58 @@ impl Normalization {
             let s = self.output_std[i % dy];
             *m = *m * s + self.output_mean[i % dy];
             *v *= s * s;
+        }
+    }
+
+    /// The training set's normalization: per-channel mean and std (ddof 0; std 1 for constant
+    /// channels) of the inputs (`D_u = n_input`) and outputs (`D_y = n_output`) of `sequences`.
+    pub fn of_sequences<'a>(
+        sequences: &[SequenceView<'a>],
+        n_input: usize,
+        n_output: usize,
+    ) -> Self {
+        let stats = |d: usize, get: &dyn Fn(&SequenceView<'a>) -> &'a [f64]| {
+            let mut mean = vec![0.0; d];
+            let mut n = 0.0;
+            for s in sequences {
+                for row in get(s).chunks_exact(d.max(1)) {
+                    mean.iter_mut().zip(row).for_each(|(m, v)| *m += v);
+                    n += 1.0;
+                }
+            }
+            mean.iter_mut().for_each(|m| *m /= f64::max(n, 1.0));
+            let mut var = vec![0.0; d];
+            for s in sequences {
+                for row in get(s).chunks_exact(d.max(1)) {
+                    for ((v, x), m) in var.iter_mut().zip(row).zip(&mean) {
+                        *v += (x - m) * (x - m);
+                    }
+                }
+            }
+            let std = var
+                .iter()
+                .map(|v| {
+                    let s = (v / f64::max(n, 1.0)).sqrt();
+                    if s > 0.0 && s.is_finite() { s } else { 1.0 }
+                })
+                .collect::<Vec<_>>();
+            (mean, std)
+        };
+        let (input_mean, input_std) = stats(n_input, &|s| s.inputs);
+        let (output_mean, output_std) = stats(n_output, &|s| s.outputs);
+        Self {
+            input_mean,
+            input_std,
+            output_mean,
+            output_std,
+        }
+    }
+
+    /// A raw sequence standardized (a new sequence).
+    pub fn standardize_sequence(&self, s: SequenceView<'_>) -> Sequence {
+        Sequence {
+            inputs: self.standardize_inputs(s.inputs),
+            outputs: self.standardize_outputs(s.outputs),
         }
     }
 }
@@ -177,5 +231,53 @@ impl PrssmModel {
             n.outputs_to_physical(&mut pred.output_mean, &mut pred.output_var);
         }
         Ok((pred, all))
+    }
+
+    /// The initial-state rule the model was trained with (the `initial_state` of its training
+    /// record, [`crate::train::fit::training_record`]); `x₀ = 0` for a model without one (an
+    /// imported model).
+    pub fn initial_state_rule(&self) -> InitialStateModel {
+        self.training
+            .get("initial_state")
+            .and_then(|v| serde_json::from_value(v.clone()).ok())
+            .unwrap_or(InitialStateModel {
+                spec: InitialStateSpec::Zeros,
+                recognition: None,
+                params: Vec::new(),
+            })
+    }
+
+    /// Open-loop prediction of a raw sequence from the model's initial-state rule
+    /// ([`Self::initial_state_rule`]). `seq.outputs` may be empty for the
+    /// zero rule; the other rules read the first steps of the outputs. Output moments are in raw
+    /// units, latent moments standardized.
+    ///
+    /// # Errors
+    /// [`PredictionError`] for mismatched shapes, a missing initial-state input or a failed
+    /// prediction.
+    pub fn predict_sequence(
+        &self,
+        seq: SequenceView<'_>,
+        particles: usize,
+        seed: u64,
+    ) -> Result<Prediction, PredictionError> {
+        let initial = self.initial_state_rule();
+        let z = self
+            .normalization
+            .as_ref()
+            .map(|n| n.standardize_sequence(seq));
+        let z = z.as_ref().map_or(seq, Sequence::view);
+        let mut pred = predict::predict_standardized(
+            &self.config,
+            &self.params,
+            &initial,
+            z,
+            particles,
+            seed,
+        )?;
+        if let Some(n) = &self.normalization {
+            n.outputs_to_physical(&mut pred.output_mean, &mut pred.output_var);
+        }
+        Ok(pred)
     }
 }

@@ -10,9 +10,11 @@ use rand_distr::{Distribution, StandardNormal};
 use serde::{Deserialize, Serialize};
 
 use crate::conditional::{Posterior, PredictiveWorkspace};
+use crate::elbo::SequenceView;
 use crate::objective::ObjectiveError;
 use crate::params::{ModelConfig, Params};
 use crate::precision::Precision;
+use crate::train::initial::{InitialStateError, InitialStateModel};
 
 /// Predictive moments over `T` steps.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -47,6 +49,46 @@ pub(crate) fn prediction_posterior(
         return Err(ObjectiveError::Shape("particles must be ≥ 1".into()));
     }
     Posterior::new(config, params)
+}
+
+/// Why a prediction from a sequence's initial-state rule failed.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum PredictionError {
+    /// The prediction failed (shapes, factorization).
+    #[error(transparent)]
+    Objective(#[from] ObjectiveError),
+    /// The initial state could not be formed from the sequence.
+    #[error(transparent)]
+    InitialState(#[from] InitialStateError),
+}
+
+/// Open-loop prediction of a standardized sequence from its initial-state rule; moments in
+/// standardized units.
+///
+/// # Errors
+/// [`PredictionError`] when the initial state cannot be formed or the prediction fails.
+pub fn predict_standardized(
+    config: &ModelConfig,
+    params: &Params,
+    initial: &InitialStateModel,
+    seq: SequenceView<'_>,
+    particles: usize,
+    seed: u64,
+) -> Result<Prediction, PredictionError> {
+    let dx = config.n_state;
+    let (mut m0, mut s0) = (vec![0.0; dx], vec![0.0; dx]);
+    initial.state(
+        (config.n_input, config.n_output),
+        seq.inputs,
+        seq.outputs,
+        0,
+        &mut m0,
+        &mut s0,
+    )?;
+    Ok(predict(
+        config, params, seq.inputs, &m0, &s0, particles, seed,
+    )?)
 }
 
 /// One transition step for `P` particles on caller buffers (for streaming prediction).

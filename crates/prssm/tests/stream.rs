@@ -7,7 +7,6 @@ use std::cell::Cell;
 use flapssm_prssm::params::{ModelConfig, ParamInit, Params};
 use flapssm_prssm::predict;
 use flapssm_prssm::stream::StreamPredictor;
-use flapssm_prssm::train::fit::predict_raw;
 use flapssm_prssm::{Normalization, PrssmModel, Sequence};
 
 struct Counting;
@@ -75,7 +74,7 @@ fn streaming_equals_batch_prediction_bit_for_bit() {
             inputs: u.clone(),
             outputs: Vec::new(),
         };
-        let batch = predict_raw(&model, seq.view(), 25, 99).unwrap();
+        let batch = model.predict_sequence(seq.view(), 25, 99).unwrap();
         let mut stream =
             StreamPredictor::new(&model, 25, &vec![0.0; dx], &vec![0.0; dx], 99).unwrap();
         for t in 0..t_n {

@@ -5,8 +5,9 @@
 mod common;
 
 use flapssm_prssm::Elbo;
-use flapssm_prssm::systems::{Duffing, duffing_dataset};
-use flapssm_prssm::train::fit::{FitSpec, Preset, fit, predict_raw};
+mod systems;
+
+use flapssm_prssm::train::fit::{FitSpec, Preset, fit};
 use flapssm_prssm::train::{
     Budget, InitialStateSpec, LrSchedule, RecognitionConfig, RecognizedElbo, TrainEvent,
     TrainHooks, WindowSpec,
@@ -15,8 +16,9 @@ use flapssm_prssm::{
     ElboOptions, InitialStateMode, KernelKind, LossScaling, ModelConfig, Objective, ParamInit,
     Params, Sequence, SequenceView, TrainingData, Window,
 };
+use systems::{Duffing, duffing_dataset};
 
-fn sequences(data: &flapssm_prssm::systems::SimulatedData) -> Vec<Sequence> {
+fn sequences(data: &systems::SimulatedData) -> Vec<Sequence> {
     data.inputs
         .iter()
         .zip(&data.outputs)
@@ -155,7 +157,10 @@ fn learns_a_forced_duffing_oscillator_with_calibrated_intervals() {
 
     let (mut se, mut inside, mut n) = (0.0, 0, 0);
     for (i, seq) in test.iter().enumerate() {
-        let pred = predict_raw(&out.last, seq.view(), 100, 1000 + i as u64).unwrap();
+        let pred = out
+            .last
+            .predict_sequence(seq.view(), 100, 1000 + i as u64)
+            .unwrap();
         for t in 0..seq.outputs.len() {
             let (m, v, y) = (pred.output_mean[t], pred.output_var[t], seq.outputs[t]);
             se += (m - y) * (m - y);

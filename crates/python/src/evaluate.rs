@@ -3,10 +3,7 @@
 
 use std::path::PathBuf;
 
-use flapssm_jobs::evaluate::{EVALUATION_FILES, EvalOptions, ReportContext};
-use flapssm_jobs::models::LoadModel;
-use flapssm_jobs::models::lrqsm::LrqsmLoadModel;
-use flapssm_jobs::models::prssm::PrssmLoadModel;
+use flapssm_jobs::evaluate::{EVALUATION_FILES, EvalOptions, EvaluationModels, evaluate_models};
 use pyo3::prelude::*;
 
 use crate::dataset::Dataset;
@@ -40,30 +37,20 @@ pub fn evaluate(
         ..EvalOptions::default()
     };
     let ds = &dataset.inner;
-    let p = prssm
-        .map(|m| PrssmLoadModel::new(&m.model, ds, particles, seed))
-        .transpose()
-        .map_err(|e| job_error(e, None))?;
-    let l = lrqsm
-        .map(|m| LrqsmLoadModel::new(&m.model))
-        .transpose()
-        .map_err(|e| job_error(e, None))?;
-    let mut models: Vec<&dyn LoadModel> = Vec::new();
-    if let Some(p) = &p {
-        models.push(p);
-    }
-    if let Some(l) = &l {
-        models.push(l);
-    }
+    let models = EvaluationModels {
+        prssm: prssm.map(|m| &m.model),
+        lrqsm: lrqsm.map(|m| &m.model),
+        ..EvaluationModels::default()
+    };
     let bar = PyProgress::new(progress);
     let report = py
         .detach(|| {
-            flapssm_jobs::evaluate::evaluate(
+            evaluate_models(
                 ds,
                 "python dataset",
                 &models,
                 &opts,
-                &ReportContext::default(),
+                serde_json::Value::Null,
                 &out,
                 &bar,
             )

@@ -1,4 +1,4 @@
-//! # flapssm-qs — the quasi-steady baseline (LRQSM)
+//! # flapssm-qs — the linear baselines: the quasi-steady LRQSM and an ARX with input memory
 //!
 //! Elastic net with a regularization path and K-fold cross-validation, fitted per output on
 //! quasi-steady kinematic features, as the published baseline did with MATLAB's
@@ -9,8 +9,10 @@
 //! - [`model`]: the versioned JSON model file ([`model::LrqsmModel`]) and prediction.
 //! - [`lrqsm`]: fit on a dataset's training trajectories, predict every trajectory.
 //! - [`table`]: fits on custom columns of a CSV table.
+//! - [`arx`]: least squares on lagged standardized inputs (a linear model with input memory).
 #![warn(missing_docs)]
 
+pub mod arx;
 pub mod cv;
 pub mod enet;
 pub mod error;

@@ -4,13 +4,9 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 use clap::Args;
-use flapssm_jobs::evaluate::{EVALUATION_FILES, EvalOptions, ReportContext, evaluate};
-use flapssm_jobs::models::lrqsm::LrqsmLoadModel;
-use flapssm_jobs::models::prssm::PrssmLoadModel;
-use flapssm_jobs::models::{LoadModel, baseline};
-use flapssm_jobs::rig::{
-    RIG_FILES, RigSettings, load_reference_model, rig_check, rig_reference, write_rig_check,
-};
+use flapssm_jobs::evaluate::{EVALUATION_FILES, EvalOptions, EvaluationModels, evaluate_models};
+use flapssm_jobs::models::baseline;
+use flapssm_jobs::rig::RIG_FILES;
 use flapssm_prssm::PrssmModel;
 use flapssm_qs::LrqsmModel;
 use flapssm_wing::dataset::Dataset;
@@ -94,78 +90,24 @@ pub fn run(a: EvaluateArgs) -> anyhow::Result<()> {
             LrqsmModel::load(p).with_context(|| format!("loading LRQSM model {}", p.display()))
         })
         .transpose()?;
-    let prssm = prssm
-        .as_ref()
-        .map(|m| PrssmLoadModel::new(m, &ds, opts.particles, opts.seed))
-        .transpose()
-        .with_context(|| format!("PR-SSM on {}", a.dataset.display()))?;
-    let lrqsm = lrqsm
-        .as_ref()
-        .map(LrqsmLoadModel::new)
-        .transpose()
-        .with_context(|| format!("LRQSM on {}", a.dataset.display()))?;
-    let bars = Bars::new();
-    let baselines = a
-        .baseline
-        .iter()
-        .map(|k| {
-            let b = baseline(k)?;
-            (b.fit)(&ds, &bars)
-                .with_context(|| format!("fitting the {k} baseline on {}", a.dataset.display()))
-        })
-        .collect::<anyhow::Result<Vec<_>>>()?;
-    let mut models: Vec<&dyn LoadModel> = Vec::new();
-    if let Some(m) = &prssm {
-        models.push(m);
-    }
-    if let Some(m) = &lrqsm {
-        models.push(m);
-    }
-    models.extend(baselines.iter().map(|m| &**m));
-    let rig_section = match &a.reference {
-        Some(path) => {
-            let model = load_reference_model(path)?;
-            let reference = rig_reference(&model, ds.len(), &RigSettings::default(), &bars)
-                .context("predicting the rig reference")?;
-            let check = rig_check(&ds, &reference, true)
-                .with_context(|| format!("checking {} against the rig", a.dataset.display()))?;
-            write_rig_check(
-                &a.out,
-                &check,
-                &ds,
-                &reference,
-                &a.dataset.display().to_string(),
-            )?;
-            let figure = a.out.join(RIG_FILES[2]);
-            Some(check.report_section(figure.exists().then_some(figure)))
-        }
-        None => None,
+    let models = EvaluationModels {
+        prssm: prssm.as_ref(),
+        lrqsm: lrqsm.as_ref(),
+        baselines: &a.baseline,
+        reference: a.reference.as_deref(),
     };
-    let ctx = ReportContext {
-        intro: format!(
-            "{} evaluated on {}.",
-            models
-                .iter()
-                .map(|m| m.name())
-                .collect::<Vec<_>>()
-                .join(", "),
-            a.dataset.display()
-        ),
-        config: serde_json::json!({
-            "dataset": a.dataset, "prssm": a.prssm, "lrqsm": a.lrqsm, "baselines": a.baseline,
-            "reference": a.reference,
-        }),
-        extra_sections: rig_section.into_iter().collect(),
-        ..ReportContext::default()
-    };
-    let r = evaluate(
+    let config = serde_json::json!({
+        "dataset": a.dataset, "prssm": a.prssm, "lrqsm": a.lrqsm, "baselines": a.baseline,
+        "reference": a.reference,
+    });
+    let r = evaluate_models(
         &ds,
         &a.dataset.display().to_string(),
         &models,
         &opts,
-        &ctx,
+        config,
         &a.out,
-        &bars,
+        &Bars::new(),
     )
     .with_context(|| format!("evaluating on {}", a.dataset.display()))?;
     let f = |v: &[f64]| {

@@ -194,7 +194,7 @@ fn merge(a: MergeArgs) -> anyhow::Result<()> {
         println!("the paper's selections beside these results:");
         print!(
             "{}",
-            flapssm_jobs::paper_comparison::markdown(&table.paper_comparison)
+            flapssm_jobs::evaluate::paper::markdown(&table.paper_comparison)
         );
     }
     println!("wrote {} (+ .json, .png)", a.out.display());

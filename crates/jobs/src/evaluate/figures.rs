@@ -1,17 +1,42 @@
-//! The evaluation's figures drawn from its tables: example choice, Fig. 3 and training curves.
+//! The evaluation's figures drawn from its tables: example choice, Figs. 2C–5 and the training
+//! curves, and the list of what was drawn for the report.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use flapssm_prssm::train::EpochRecord;
-use flapssm_wing::dataset::Dataset;
+use flapssm_wing::dataset::{Dataset, OUTPUT_NAMES, ValidDataset};
 
-use flapssm_analysis::plots::{timeseries as pt, training};
+use flapssm_analysis::metrics::Histogram;
+use flapssm_analysis::plots::{authority as pa, errors as pe, timeseries as pt, training, wing3d};
 
-use super::TrajectoryMetrics;
-use super::prepared::Prepared;
+use super::authority::Authority;
+use super::paper::FIG3_TEST_NUMBERS;
+use super::prepared::{Prepared, cycle_errors, pooled};
+use super::report::{COEFFICIENT_LABELS, EvalOptions, TrajectoryMetrics};
+use super::scores::Sets;
 use crate::error::{Result, analysis};
 use crate::models::LoadModel;
-use crate::paper_comparison::FIG3_TEST_NUMBERS;
+
+/// The figures an evaluation drew, for the report.
+pub(super) struct ReportFigures {
+    pub(super) f_2c: PathBuf,
+    pub(super) f_3: PathBuf,
+    pub(super) f_4a_train: Option<PathBuf>,
+    pub(super) f_4a_test: Option<PathBuf>,
+    pub(super) f_4b: PathBuf,
+    /// Fig. 5Ai, 5Aii, 5B, with a latent-state model.
+    pub(super) fig5: Option<(PathBuf, PathBuf, PathBuf)>,
+    /// Training loss and RMSE, with a training history.
+    pub(super) training: Option<(PathBuf, PathBuf)>,
+}
+
+impl ReportFigures {
+    /// Whether the file named `name` was written (the training curves are named before it is
+    /// known whether the history has any).
+    pub(super) fn written(&self, name: &str) -> bool {
+        !name.starts_with("training_") || self.training.is_some()
+    }
+}
 
 /// The examples of Fig. 3: on the paper's own trajectories (its 512 / 36 split, the angles of
 /// its six example test trajectories found from sample 93 on) the paper's six in its order, as
@@ -252,6 +277,131 @@ pub(super) fn draw_training(
     )
     .map_err(analysis("training RMSE figure"))?;
     Ok(true)
+}
+
+/// Draws every figure; `file` names (and records) each file.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn draw_figures(
+    ds: &ValidDataset,
+    models: &[&dyn LoadModel],
+    prep: &[Prepared],
+    sets: &Sets<'_>,
+    trajectories: &[TrajectoryMetrics],
+    authority: Option<&Authority>,
+    opts: &EvalOptions,
+    examples: &[usize],
+    file: &mut dyn FnMut(&str) -> PathBuf,
+) -> Result<ReportFigures> {
+    let n = ds.n_samples();
+    let wing = &ds.meta.wing;
+    let labels: Vec<String> = examples
+        .iter()
+        .map(|&i| example_title(ds, i, &trajectories[i]))
+        .collect();
+    let f_2c = file("fig2c_wing_motion.png");
+    let paths: Vec<wing3d::WingPath<'_>> = examples
+        .iter()
+        .zip(&labels)
+        .map(|(&i, l)| wing3d::WingPath {
+            label: l,
+            euler_rad: &ds.trajectories[i].euler_rad[prep[i].window.range(n).unwrap_or(0..=0)],
+        })
+        .collect();
+    let geom = wing3d::WingSketchGeometry {
+        r_m: wing.u_ref_radius_m,
+        chord_m: wing.chord_m,
+        pitch_axis_frac: wing.pitch_axis_frac,
+        ..Default::default()
+    };
+    wing3d::wing_motion_3d(&f_2c, &paths, &geom).map_err(analysis("Fig. 2C"))?;
+    let f_3 = file("fig3_time_histories.png");
+    draw_fig3(&f_3, ds, models, prep, examples, &labels)?;
+
+    let edges = Histogram::uniform_edges(-1.1, 1.1, 0.01);
+    let out_names = OUTPUT_NAMES
+        .iter()
+        .map(|s| format!("{s}/σ"))
+        .collect::<Vec<_>>();
+    let out_refs: Vec<&str> = out_names.iter().map(String::as_str).collect();
+    let mut f_4a = Vec::new();
+    for (set, label) in [(&sets.train, "train"), (&sets.test, "test")] {
+        if set.is_empty() {
+            continue;
+        }
+        let path = file(&format!("fig4a_histograms_{label}.png"));
+        let errors = (0..models.len())
+            .map(|k| pooled(set, k, opts.start_sample))
+            .collect::<Result<Vec<_>>>()?;
+        let labels: Vec<String> = models
+            .iter()
+            .map(|m| format!("{} {label}", m.name()))
+            .collect();
+        let series: Vec<pe::ModelErrors<'_>> = labels
+            .iter()
+            .zip(&errors)
+            .map(|(l, e)| pe::ModelErrors {
+                label: l,
+                errors: &e.errors,
+            })
+            .collect();
+        pe::error_histograms(&path, &out_refs, &series, &edges, opts.level)
+            .map_err(analysis("Fig. 4A"))?;
+        f_4a.push(path);
+    }
+    let f_4b = file("fig4b_cycle_averages.png");
+    let cycles = (0..models.len())
+        .map(|k| cycle_errors(&sets.all, k))
+        .collect::<Result<Vec<_>>>()?;
+    let series: Vec<pe::ModelCycleAverages<'_>> = models
+        .iter()
+        .zip(&cycles)
+        .map(|(m, c)| pe::ModelCycleAverages {
+            label: m.name(),
+            observed: &c.observed,
+            error: &c.error,
+        })
+        .collect();
+    pe::cycle_average_scatter(
+        &f_4b,
+        &COEFFICIENT_LABELS,
+        &series,
+        Some(&[0.75, 0.75, 2.0, 2.0, 2.0]),
+        opts.level,
+    )
+    .map_err(analysis("Fig. 4B"))?;
+    let fig5 = match authority {
+        Some(a) => {
+            let (f_5a, f_5s, f_5b) = (
+                file("fig5a_hdr.png"),
+                file("fig5a_scatter_x1.png"),
+                file("fig5b_summary.png"),
+            );
+            pa::hdr_contours(&f_5a, &a.summary).map_err(analysis("Fig. 5Ai"))?;
+            pa::pair_scatter(&f_5s, &a.table, &a.summary, 0).map_err(analysis("Fig. 5Aii"))?;
+            pa::summary_grid(&f_5b, &a.summary).map_err(analysis("Fig. 5B"))?;
+            Some((f_5a, f_5s, f_5b))
+        }
+        None => None,
+    };
+    let training = models
+        .iter()
+        .find_map(|m| m.training_history().map(|h| (m.name(), h)));
+    let training = match training {
+        Some((name, history)) => {
+            let (f_loss, f_rmse) = (file("training_loss.png"), file("training_rmse.png"));
+            draw_training(&f_loss, &f_rmse, name, history)?.then_some((f_loss, f_rmse))
+        }
+        None => None,
+    };
+    Ok(ReportFigures {
+        f_2c,
+        f_3,
+        f_4a_train: f_4a.first().cloned(),
+        f_4a_test: f_4a.get(1).cloned(),
+        f_4b,
+        fig5,
+        training,
+    })
 }
 
 #[cfg(test)]

@@ -7,28 +7,9 @@ use flapssm_wing::dataset::OUTPUT_NAMES;
 use flapssm_analysis::report::{Figure, Report, Section, Table};
 use flapssm_analysis::stats::Interval;
 
-use super::{COEFFICIENT_LABELS, EvaluationReport, ReportContext};
+use super::figures::ReportFigures;
+use super::report::{COEFFICIENT_LABELS, EvaluationReport, ReportContext};
 use crate::models::LoadModel;
-
-pub(super) struct ReportFigures {
-    pub(super) f_2c: PathBuf,
-    pub(super) f_3: PathBuf,
-    pub(super) f_4a_train: Option<PathBuf>,
-    pub(super) f_4a_test: Option<PathBuf>,
-    pub(super) f_4b: PathBuf,
-    /// Fig. 5Ai, 5Aii, 5B, with a latent-state model.
-    pub(super) fig5: Option<(PathBuf, PathBuf, PathBuf)>,
-    /// Training loss and RMSE, with a training history.
-    pub(super) training: Option<(PathBuf, PathBuf)>,
-}
-
-impl ReportFigures {
-    /// Whether the file named `name` was written (the training curves are named before it is
-    /// known whether the history has any).
-    pub(super) fn written(&self, name: &str) -> bool {
-        !name.starts_with("training_") || self.training.is_some()
-    }
-}
 
 fn f3(v: f64) -> String {
     format!("{v:.3}")
@@ -180,7 +161,7 @@ fn paper_section(r: &EvaluationReport) -> Option<Section> {
     Some(Section {
         heading: "The paper beside flapssm".into(),
         paragraphs: vec![
-            "Every quantitative endpoint of Bayiz & Cheng (2021), its value as the paper states it (figure and line of the LaTeX source) and the same measure on this evaluation. The last column says where flapssm's range lies against the paper's; the definitions are in the documentation of flapssm_jobs::paper_comparison and docs/paper-comparison.md.".into(),
+            "Every quantitative endpoint of Bayiz & Cheng (2021), its value as the paper states it (figure and line of the LaTeX source) and the same measure on this evaluation. The last column says where flapssm's range lies against the paper's; the definitions are in the documentation of flapssm_jobs::evaluate::paper and docs/paper-comparison.md.".into(),
         ],
         tables: vec![Table {
             caption: "Paper vs flapssm".into(),

@@ -23,7 +23,8 @@ use serde::{Deserialize, Serialize};
 
 use flapssm_analysis::stats::median;
 
-use crate::evaluate::{AuthorityFinding, EvaluationReport};
+use super::report::{AuthorityFinding, EvaluationReport};
+pub use super::report::{ComparisonRow, Relation};
 
 /// The paper's LaTeX source, for the `source` column.
 pub const PAPER_TEX: &str = "shared/paper/bayiz-cheng-2021-state-space-aero-model.tex";
@@ -139,60 +140,6 @@ pub fn fig5_pairs() -> impl Iterator<Item = (&'static str, usize)> {
             .iter()
             .flat_map(move |&input| c.states.iter().map(move |&state| (input, state)))
     })
-}
-
-/// Where flapssm's value lies against the paper's range.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Relation {
-    /// Inside the paper's range.
-    Inside,
-    /// Overlapping it, partly outside.
-    Overlaps,
-    /// Entirely below it.
-    Below,
-    /// Entirely above it.
-    Above,
-}
-
-impl Relation {
-    /// flapssm's range `[lo, hi]` against the paper's.
-    pub fn of(ours: [f64; 2], paper: [f64; 2]) -> Self {
-        if ours[1] < paper[0] {
-            Relation::Below
-        } else if ours[0] > paper[1] {
-            Relation::Above
-        } else if ours[0] >= paper[0] && ours[1] <= paper[1] {
-            Relation::Inside
-        } else {
-            Relation::Overlaps
-        }
-    }
-
-    /// Lower-case words.
-    pub fn words(self) -> &'static str {
-        match self {
-            Relation::Inside => "inside",
-            Relation::Overlaps => "overlaps",
-            Relation::Below => "below",
-            Relation::Above => "above",
-        }
-    }
-}
-
-/// One endpoint, the paper's value beside flapssm's.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct ComparisonRow {
-    /// The endpoint in words.
-    pub endpoint: String,
-    /// Figure and line of [`PAPER_TEX`].
-    pub source: String,
-    /// The paper's value as it states it.
-    pub paper: String,
-    /// flapssm's value, same measure.
-    pub flapssm: String,
-    /// flapssm's range against the paper's, where both are ranges.
-    pub relation: Option<Relation>,
 }
 
 fn range_text(r: [f64; 2], digits: usize) -> String {

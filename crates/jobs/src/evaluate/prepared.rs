@@ -5,7 +5,7 @@ use flapssm_analysis::cycles_avg::{CycleAverageErrors, CycleWindow};
 use flapssm_analysis::metrics::{PooledErrors, window_rmse};
 use flapssm_analysis::stats::{Rows, median};
 
-use super::{EvalOptions, SplitMetrics};
+use super::report::{EvalOptions, SplitMetrics};
 use crate::error::{Result, analysis};
 
 /// One model's tables of one trajectory.

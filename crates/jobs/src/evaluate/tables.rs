@@ -6,7 +6,7 @@ use flapssm_wing::dataset::Dataset;
 
 use flapssm_data::npz::{NpyData, NpzWriter};
 
-use super::TrajectoryMetrics;
+use super::report::TrajectoryMetrics;
 use crate::error::{JobError, Result};
 use crate::models::{LoadModel, ModelPrediction};
 

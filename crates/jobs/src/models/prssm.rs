@@ -6,12 +6,12 @@ use std::borrow::Cow;
 use flapssm_prssm::PrssmModel;
 use flapssm_prssm::predict::Prediction;
 use flapssm_prssm::train::EpochRecord;
-use flapssm_prssm::train::fit::{predict_raw, training_record};
+use flapssm_prssm::train::fit::training_record;
 use flapssm_wing::dataset::{Trajectory, ValidDataset};
 
 use super::{Fit, LoadModel, LoadPrediction, check_buffer};
+use crate::adapters::{in_dataset_units, trajectory_sequence};
 use crate::error::{JobError, Result};
-use crate::predict::{in_dataset_units, trajectory_sequence};
 use crate::progress::Progress;
 use crate::resources;
 use crate::seed::prediction_seed;
@@ -91,16 +91,16 @@ impl<'m> PrssmLoadModel<'m> {
     /// # Errors
     /// [`JobError::Prssm`] naming the trajectory.
     pub fn predict(&self, index: usize, trajectory: &Trajectory) -> Result<Prediction> {
-        predict_raw(
-            &self.model,
-            trajectory_sequence(trajectory),
-            self.particles,
-            prediction_seed(self.seed, index),
-        )
-        .map_err(|source| JobError::Prssm {
-            what: format!("prediction of trajectory {index}"),
-            source,
-        })
+        self.model
+            .predict_sequence(
+                trajectory_sequence(trajectory),
+                self.particles,
+                prediction_seed(self.seed, index),
+            )
+            .map_err(|source| JobError::Prssm {
+                what: format!("prediction of trajectory {index}"),
+                source: source.into(),
+            })
     }
 }
 

@@ -32,9 +32,10 @@ mod run;
 mod score;
 
 pub use figure::plot_test_prediction;
+pub use flapssm_analysis::scores::{MeanStd, Scores, score};
 pub use record::IoRecord;
 pub use run::{RestartRun, SeedRun, SysidReport, TestTrace, run};
-pub use score::{MeanStd, Scores, mixture, score};
+pub use score::mixture;
 
 /// Fewest training samples the protocol accepts.
 pub const MIN_TRAIN_SAMPLES: usize = 100;

@@ -6,12 +6,13 @@ use std::time::Instant;
 
 use flapssm_prssm::predict::Prediction;
 use flapssm_prssm::train::TrainHooks;
-use flapssm_prssm::train::fit::{FitError, fit, predict_raw};
+use flapssm_prssm::train::fit::{FitError, fit};
 use serde::{Deserialize, Serialize};
 
-use super::score::{MeanStd, Scores, mixture, score};
+use super::score::mixture;
 use super::{Combine, IoRecord, SysidError, SysidSpec, split_counts};
 use crate::seed::{SYSID_PREDICTION_STREAM, SYSID_RESTART_STREAM, derive_seed};
+use flapssm_analysis::scores::{MeanStd, Scores, rmse_per_channel, score};
 
 /// One fitted restart: its record and test-part predictions (raw units).
 struct Restart {
@@ -131,7 +132,7 @@ pub fn run(
     }
     let train = record.sequence(0..n_train);
     let test = record.sequence(n_train..n);
-    let norm = flapssm_prssm::train::fit::normalization(std::slice::from_ref(&train), du, dy);
+    let norm = flapssm_prssm::Normalization::of_sequences(std::slice::from_ref(&train), du, dy);
     let mean_pred: Vec<f64> = (0..test.outputs.len())
         .map(|i| norm.output_mean[i % dy])
         .collect();
@@ -169,10 +170,11 @@ pub fn run(
                 None,
             )?;
             let predict_seed = derive_seed(seed, SYSID_PREDICTION_STREAM, r as u64);
-            let best = predict_raw(&out.best, test, spec.predict_particles, predict_seed)?;
+            let best = out
+                .best
+                .predict_sequence(test, spec.predict_particles, predict_seed)?;
             let last = match diagnose_last || spec.combine == Combine::Snapshots {
-                true => Some(predict_raw(
-                    &out.last,
+                true => Some(out.last.predict_sequence(
                     test,
                     spec.predict_particles,
                     predict_seed,
@@ -241,22 +243,7 @@ pub fn run(
         let last_scores = combined(&|f| f.last.as_ref()).map(|p| score_of(&p));
         let wall_s = t0.elapsed().as_secs_f64();
         let test_scores = score_of(&pred);
-        let rmse_per_output = (0..dy)
-            .map(|j| {
-                let (mut s2, mut k) = (0.0, 0.0);
-                for (y, m) in test
-                    .outputs
-                    .iter()
-                    .zip(&pred.output_mean)
-                    .skip(j)
-                    .step_by(dy)
-                {
-                    s2 += (y - m) * (y - m);
-                    k += 1.0;
-                }
-                (s2 / f64::max(k, 1.0)).sqrt()
-            })
-            .collect();
+        let rmse_per_output = rmse_per_channel(test.outputs, &pred.output_mean, dy);
         let r = SeedRun {
             seed,
             test: test_scores,
@@ -299,26 +286,6 @@ pub fn run(
 mod tests {
     use super::*;
     use flapssm_data::table::{Column, Table};
-
-    #[test]
-    fn scores_match_hand_computed_values() {
-        // Two outputs with training stds 2 and 0.5; raw errors (2, 0.5) and (0, -1).
-        let std = [2.0, 0.5];
-        let y = [1.0, 1.0, 3.0, 0.0];
-        let m = [-1.0, 0.5, 3.0, 1.0];
-        let v = [4.0, 0.25, 16.0, 1.0];
-        let s = score(&y, &m, &v, &std);
-        assert!((s.rmse - ((4.0 + 0.25 + 0.0 + 1.0) / 4.0f64).sqrt()).abs() < 1e-15);
-        // Standardized: (e, v) = (1, 1), (1, 1), (0, 4), (-2, 4).
-        let ln2pi = (2.0 * std::f64::consts::PI).ln();
-        let nll = [
-            0.5 * ln2pi + 0.5,
-            0.5 * ln2pi + 0.5,
-            0.5 * (ln2pi + 4f64.ln()),
-            0.5 * (ln2pi + 4f64.ln()) + 0.5,
-        ];
-        assert!((s.nll - nll.iter().sum::<f64>() / 4.0).abs() < 1e-14);
-    }
 
     fn prediction(mean: &[f64], var: &[f64]) -> Prediction {
         Prediction {
@@ -370,13 +337,6 @@ mod tests {
             let mean_member = members.iter().map(rmse).sum::<f64>() / members.len() as f64;
             assert!(rmse(&mix) <= mean_member + 1e-12);
         }
-    }
-
-    #[test]
-    fn mean_std_is_population_std() {
-        let ms = MeanStd::of([1.0, 2.0, 3.0, 6.0]);
-        assert_eq!(ms.mean, 3.0);
-        assert!((ms.std - 3.5f64.sqrt()).abs() < 1e-15);
     }
 
     #[test]

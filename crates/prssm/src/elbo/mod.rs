@@ -42,7 +42,7 @@ pub struct Sequence {
 
 /// A borrowed sequence: the caller's own `T × D_u` inputs and `T × D_y` outputs (row-major),
 /// with no copy. The raw data of [`crate::train::fit::fit`] and
-/// [`crate::train::fit::predict_raw`] come in as views.
+/// [`crate::PrssmModel::predict_sequence`] come in as views.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SequenceView<'a> {
     /// Inputs `u`, row-major `T × D_u`.

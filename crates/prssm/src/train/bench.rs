@@ -4,6 +4,10 @@
 
 use std::time::Instant;
 
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use rand_distr::StandardNormal;
+
 use faer::linalg::matmul::matmul;
 use faer::linalg::triangular_solve::solve_lower_triangular_in_place;
 use faer::traits::ComplexField;
@@ -17,8 +21,25 @@ use crate::params::{ModelConfig, Params};
 use crate::precision::Precision;
 use crate::predict;
 use crate::stream::StreamPredictor;
-use crate::systems::random_input;
 use crate::{Objective, ObjectiveError, Window};
+
+/// Smooth random excitation: Gaussian levels of standard deviation `amplitude`, held for
+/// `hold` samples, passed through a first-order low-pass `ū_t = ū_{t−1} + (u_t − ū_{t−1})/2`.
+pub fn random_input(len: usize, amplitude: f64, hold: usize, seed: u64) -> Vec<f64> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let hold = hold.max(1);
+    let mut level = 0.0;
+    let mut smooth = 0.0;
+    (0..len)
+        .map(|t| {
+            if t % hold == 0 {
+                level = amplitude * rng.sample::<f64, _>(StandardNormal);
+            }
+            smooth += 0.5 * (level - smooth);
+            smooth
+        })
+        .collect()
+}
 
 /// FLOP of one training transition step (forward + backward) of `n_points`
 /// particle-windows, dominant terms: the three `M × M × N` products `W = G K`, `Y = Gᵀ W̄`

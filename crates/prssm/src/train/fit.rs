@@ -1,6 +1,6 @@
 //! Fitting a PR-SSM to raw sequences: presets, standardization, validation metrics, the
-//! training loop and the resulting [`PrssmModel`]s (best and last); prediction with the
-//! model's initial-state rule.
+//! training loop and the resulting [`PrssmModel`]s (best and last). Prediction with the
+//! model's initial-state rule is [`PrssmModel::predict_sequence`].
 //!
 //! Presets ([`Preset`]):
 //!
@@ -300,6 +300,9 @@ pub enum FitError {
     /// An initial state could not be formed.
     #[error(transparent)]
     InitialState(#[from] super::initial::InitialStateError),
+    /// A prediction from the model's initial-state rule failed.
+    #[error(transparent)]
+    Prediction(#[from] crate::predict::PredictionError),
 }
 
 /// The result of [`fit`].
@@ -311,85 +314,6 @@ pub struct FitOutcome {
     pub last: PrssmModel,
     /// The raw training outcome (state, interruption flag).
     pub outcome: TrainOutcome,
-}
-
-/// Training-set normalization: per-channel mean and std (ddof 0; std 1 for constant channels).
-pub fn normalization<'a>(
-    sequences: &[SequenceView<'a>],
-    n_input: usize,
-    n_output: usize,
-) -> Normalization {
-    let stats = |d: usize, get: &dyn Fn(&SequenceView<'a>) -> &'a [f64]| {
-        let mut mean = vec![0.0; d];
-        let mut n = 0.0;
-        for s in sequences {
-            for row in get(s).chunks_exact(d.max(1)) {
-                mean.iter_mut().zip(row).for_each(|(m, v)| *m += v);
-                n += 1.0;
-            }
-        }
-        mean.iter_mut().for_each(|m| *m /= f64::max(n, 1.0));
-        let mut var = vec![0.0; d];
-        for s in sequences {
-            for row in get(s).chunks_exact(d.max(1)) {
-                for ((v, x), m) in var.iter_mut().zip(row).zip(&mean) {
-                    *v += (x - m) * (x - m);
-                }
-            }
-        }
-        let std = var
-            .iter()
-            .map(|v| {
-                let s = (v / f64::max(n, 1.0)).sqrt();
-                if s > 0.0 && s.is_finite() { s } else { 1.0 }
-            })
-            .collect::<Vec<_>>();
-        (mean, std)
-    };
-    let (input_mean, input_std) = stats(n_input, &|s| s.inputs);
-    let (output_mean, output_std) = stats(n_output, &|s| s.outputs);
-    Normalization {
-        input_mean,
-        input_std,
-        output_mean,
-        output_std,
-    }
-}
-
-/// Standardizes a raw sequence with `norm` (a new sequence).
-pub fn standardize(s: SequenceView<'_>, norm: &Normalization) -> Sequence {
-    Sequence {
-        inputs: norm.standardize_inputs(s.inputs),
-        outputs: norm.standardize_outputs(s.outputs),
-    }
-}
-
-/// Open-loop prediction of a standardized sequence from its initial-state rule; moments in
-/// standardized units.
-///
-/// # Errors
-/// [`FitError`] when the initial state cannot be formed or the prediction fails.
-pub fn predict_standardized(
-    config: &ModelConfig,
-    params: &Params,
-    initial: &InitialStateModel,
-    seq: SequenceView<'_>,
-    particles: usize,
-    seed: u64,
-) -> Result<Prediction, FitError> {
-    let dx = config.n_state;
-    let (mut m0, mut s0) = (vec![0.0; dx], vec![0.0; dx]);
-    initial.state(
-        (config.n_input, config.n_output),
-        seq.inputs,
-        seq.outputs,
-        0,
-        &mut m0,
-        &mut s0,
-    )?;
-    Ok(predict::predict(
-        config, params, seq.inputs, &m0, &s0, particles, seed,
-    )?)
 }
 
 fn record(
@@ -436,9 +360,15 @@ pub fn fit(
     // Validate shapes before computing statistics.
     let lens = sequence_lengths(du, dy, train_raw.iter().copied())?;
     sequence_lengths(du, dy, val_raw.iter().copied())?;
-    let norm = normalization(train_raw, du, dy);
-    let train_z: Vec<Sequence> = train_raw.iter().map(|s| standardize(*s, &norm)).collect();
-    let val_z: Vec<Sequence> = val_raw.iter().map(|s| standardize(*s, &norm)).collect();
+    let norm = Normalization::of_sequences(train_raw, du, dy);
+    let train_z: Vec<Sequence> = train_raw
+        .iter()
+        .map(|s| norm.standardize_sequence(*s))
+        .collect();
+    let val_z: Vec<Sequence> = val_raw
+        .iter()
+        .map(|s| norm.standardize_sequence(*s))
+        .collect();
     let data = TrainingData::new(du, dy, train_z)?;
     let plan = BatchPlan::new(&lens, spec.train.windows, spec.train.batch_size)
         .map_err(TrainError::from)?;
@@ -493,7 +423,7 @@ pub fn fit(
         let initial = initial_of(flat);
         // The rollouts in parallel (each has its own seed), the sum in sequence order.
         let rollout = |(i, seq): (usize, &Sequence)| {
-            predict_standardized(
+            predict::predict_standardized(
                 cfg,
                 &p,
                 &initial,
@@ -564,37 +494,6 @@ pub fn fit(
         last: model_of(outcome.last_params(), "last")?,
         outcome,
     })
-}
-
-/// Open-loop prediction of a raw sequence with a model written by [`fit`] (or any model:
-/// without a training record the initial state is zero). `seq.outputs` may be empty for the
-/// zero rule; the other rules read the first steps of the outputs. Output moments are in raw
-/// units, latent moments standardized.
-///
-/// # Errors
-/// [`FitError`] for mismatched shapes, a missing initial-state input or a failed prediction.
-pub fn predict_raw(
-    model: &PrssmModel,
-    seq: SequenceView<'_>,
-    particles: usize,
-    seed: u64,
-) -> Result<Prediction, FitError> {
-    let initial = match training_record(model) {
-        Ok(r) => r.initial_state,
-        Err(_) => InitialStateModel {
-            spec: InitialStateSpec::Zeros,
-            recognition: None,
-            params: Vec::new(),
-        },
-    };
-    let z = model.normalization.as_ref().map(|n| standardize(seq, n));
-    let z = z.as_ref().map_or(seq, Sequence::view);
-    let mut pred =
-        predict_standardized(&model.config, &model.params, &initial, z, particles, seed)?;
-    if let Some(n) = &model.normalization {
-        n.outputs_to_physical(&mut pred.output_mean, &mut pred.output_var);
-    }
-    Ok(pred)
 }
 
 /// A fingerprint of raw sequences: count, total length and an FNV-1a hash of every value's bits.

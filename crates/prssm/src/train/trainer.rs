@@ -443,30 +443,16 @@ fn all_finite(v: &[f64]) -> bool {
     v.iter().all(|x| x.is_finite())
 }
 
-/// Trains `objective` from `init` (or from `resume`) on sequences of lengths `seq_lens`.
-///
-/// Returns the final state, also when interrupted through `hooks.stop` (then
-/// [`TrainOutcome::interrupted`] is set and a checkpoint was written to `hooks.checkpoint`).
-/// A resumed run ends bit-identical to an uninterrupted one with the same configuration.
-///
-/// # Errors
-/// [`TrainError`]: invalid configuration, windows, parameter count or checkpoint; objective
-/// failure; divergence that the learning-rate reduction could not cure.
-pub fn train<O: Objective + ?Sized>(
-    objective: &O,
-    seq_lens: &[usize],
+/// The state a run starts from: the checkpoint's (checked against `config`; returned with the
+/// checkpoint's configuration) or a fresh one at `init`.
+fn start_state(
+    resume: Option<Checkpoint>,
     init: &[f64],
     config: &TrainConfig,
-    hooks: TrainHooks<'_>,
-    resume: Option<Checkpoint>,
-) -> Result<TrainOutcome, TrainError> {
-    config.check()?;
-    let n = objective.n_params();
-    let plan = BatchPlan::new(seq_lens, config.windows, config.batch_size)?;
-    let bpe = plan.batches_per_epoch() as u64;
-    let total_steps = config.total_steps(plan.batches_per_epoch());
-    let mut resumed_from = None;
-    let mut state = match resume {
+    n: usize,
+    total_steps: u64,
+) -> Result<(TrainState, Option<TrainConfig>), TrainError> {
+    Ok(match resume {
         Some(ck) => {
             // Only the budget may grow (the run is then extended from where it stopped) and the
             // checkpoint interval change: neither touches the arithmetic of a step.
@@ -493,8 +479,8 @@ pub fn train<O: Objective + ?Sized>(
                     why: format!("{} values, the objective has {n}", ck.state.params.len()),
                 });
             }
-            resumed_from = Some(ck.config);
-            ck.state
+            let state = ck.state;
+            (state, Some(ck.config))
         }
         None => {
             if init.len() != n {
@@ -503,21 +489,154 @@ pub fn train<O: Objective + ?Sized>(
                     expected: n,
                 });
             }
-            TrainState {
-                step: 0,
-                params: init.to_vec(),
-                adam: Adam::new(n, config.adam),
-                prev: None,
-                lr_scale: 1.0,
-                ema_loss: None,
-                rejected: 0,
-                epoch_loss_sum: 0.0,
-                epoch_batches: 0,
-                best: None,
-                history: Vec::new(),
-            }
+            (
+                TrainState {
+                    step: 0,
+                    params: init.to_vec(),
+                    adam: Adam::new(n, config.adam),
+                    prev: None,
+                    lr_scale: 1.0,
+                    ema_loss: None,
+                    rejected: 0,
+                    epoch_loss_sum: 0.0,
+                    epoch_batches: 0,
+                    best: None,
+                    history: Vec::new(),
+                },
+                None,
+            )
         }
+    })
+}
+
+/// The loss and gradient (into `grad`) of step `t` on `batch`, once accepted: a non-finite loss
+/// or gradient, or a jump of the loss that the previous parameters do not share on the same
+/// batch and draws, rejects the last step (its parameters restored, the rate scaled down by
+/// the divergence guard, the step retaken) up to `max_retries` times.
+#[allow(clippy::too_many_arguments)]
+fn accepted_loss<O: Objective + ?Sized>(
+    objective: &O,
+    state: &mut TrainState,
+    config: &TrainConfig,
+    batch: &[Window],
+    seed: u64,
+    t: u64,
+    grad: &mut [f64],
+    scratch: &mut [f64],
+    emit: &mut dyn FnMut(&TrainEvent<'_>),
+) -> Result<f64, TrainError> {
+    let mut retry = 0u32;
+    loop {
+        let reason = match objective.loss_and_grad(&state.params, batch, seed, grad) {
+            Ok(l) if !l.is_finite() => format!("loss is {l}"),
+            Ok(_) if !all_finite(grad) => "gradient is not finite".to_string(),
+            Ok(l) => match (state.ema_loss, config.divergence.loss_jump, &state.prev) {
+                (Some(avg), Some(jump), Some(prev)) if l > avg + jump * (avg.abs() + 1.0) => {
+                    // A hard minibatch or a bad step? Compare on the same batch and draws.
+                    match objective.loss_and_grad(&prev.params, batch, seed, scratch) {
+                        Ok(l_prev) if l > l_prev + jump * (l_prev.abs() + 1.0) => format!(
+                            "loss {l:.6e} jumped above {l_prev:.6e} before the last step \
+                             (running loss {avg:.6e})"
+                        ),
+                        _ => return Ok(l),
+                    }
+                }
+                _ => return Ok(l),
+            },
+            Err(
+                e @ (ObjectiveError::NonFinite { .. } | ObjectiveError::NotPositiveDefinite { .. }),
+            ) => e.to_string(),
+            Err(source) => return Err(TrainError::Objective { step: t, source }),
+        };
+        let Some(prev) = state.prev.as_ref() else {
+            return Err(TrainError::BadStart { step: t, reason });
+        };
+        retry += 1;
+        if retry > config.divergence.max_retries {
+            return Err(TrainError::Diverged {
+                step: t,
+                retries: retry - 1,
+                lr_scale: state.lr_scale,
+                reason,
+            });
+        }
+        state.rejected += 1;
+        state.lr_scale *= config.divergence.lr_factor;
+        state.params.copy_from_slice(&prev.params);
+        state.adam.copy_from(&prev.adam);
+        state
+            .adam
+            .step(&mut state.params, &prev.grad, prev.lr * state.lr_scale);
+        emit(&TrainEvent::Rejected {
+            step: t,
+            reason,
+            lr_scale: state.lr_scale,
+            retry,
+        });
+    }
+}
+
+/// The record of an evaluated epoch: the evaluator's metrics of the current parameters, the
+/// epoch's mean loss, and the best model replaced when the score (by `config.best_by`) improves.
+fn record_epoch(
+    state: &mut TrainState,
+    config: &TrainConfig,
+    evaluate: Option<&mut &mut Evaluator<'_>>,
+    epoch: u64,
+    lr: f64,
+) -> Result<(), TrainError> {
+    let metrics = match evaluate {
+        Some(f) => f(&state.params).map_err(|message| TrainError::Evaluation { epoch, message })?,
+        None => Evaluation::default(),
     };
+    let mean_loss = state.epoch_loss_sum / state.epoch_batches.max(1) as f64;
+    let score = match config.best_by {
+        BestBy::Rmse => metrics.val_rmse.or(metrics.train_rmse).unwrap_or(mean_loss),
+        BestBy::TrainingLoss => mean_loss,
+    };
+    let is_best = score.is_finite() && state.best.as_ref().is_none_or(|b| score < b.score);
+    if is_best {
+        state.best = Some(BestModel {
+            params: state.params.clone(),
+            score,
+            epoch,
+        });
+    }
+    state.history.push(EpochRecord {
+        epoch,
+        step: state.step,
+        mean_loss,
+        train_rmse: metrics.train_rmse,
+        val_rmse: metrics.val_rmse,
+        lr,
+        is_best,
+    });
+    Ok(())
+}
+
+/// Trains `objective` from `init` (or from `resume`) on sequences of lengths `seq_lens`.
+///
+/// Returns the final state, also when interrupted through `hooks.stop` (then
+/// [`TrainOutcome::interrupted`] is set and a checkpoint was written to `hooks.checkpoint`).
+/// A resumed run ends bit-identical to an uninterrupted one with the same configuration.
+///
+/// # Errors
+/// [`TrainError`]: invalid configuration, windows, parameter count or checkpoint; objective
+/// failure; divergence that the learning-rate reduction could not cure.
+pub fn train<O: Objective + ?Sized>(
+    objective: &O,
+    seq_lens: &[usize],
+    init: &[f64],
+    config: &TrainConfig,
+    hooks: TrainHooks<'_>,
+    resume: Option<Checkpoint>,
+) -> Result<TrainOutcome, TrainError> {
+    config.check()?;
+    let n = objective.n_params();
+    let plan = BatchPlan::new(seq_lens, config.windows, config.batch_size)?;
+    let bpe = plan.batches_per_epoch() as u64;
+    let total_steps = config.total_steps(plan.batches_per_epoch());
+    let (mut state, resumed_from) = start_state(resume, init, config, n, total_steps)?;
     let TrainHooks {
         mut evaluate,
         mut progress,
@@ -587,56 +706,17 @@ pub fn train<O: Objective + ?Sized>(
         let seed = derive_seed(config.seed, OBJECTIVE_STREAM, t);
         let lr_sched = config.lr * config.schedule.factor(t, total_steps);
 
-        let mut retry = 0u32;
-        let loss = loop {
-            let reason = match objective.loss_and_grad(&state.params, &batch, seed, &mut grad) {
-                Ok(l) if !l.is_finite() => format!("loss is {l}"),
-                Ok(_) if !all_finite(&grad) => "gradient is not finite".to_string(),
-                Ok(l) => match (state.ema_loss, config.divergence.loss_jump, &state.prev) {
-                    (Some(avg), Some(jump), Some(prev)) if l > avg + jump * (avg.abs() + 1.0) => {
-                        // A hard minibatch or a bad step? Compare on the same batch and draws.
-                        match objective.loss_and_grad(&prev.params, &batch, seed, &mut scratch) {
-                            Ok(l_prev) if l > l_prev + jump * (l_prev.abs() + 1.0) => format!(
-                                "loss {l:.6e} jumped above {l_prev:.6e} before the last step \
-                                 (running loss {avg:.6e})"
-                            ),
-                            _ => break l,
-                        }
-                    }
-                    _ => break l,
-                },
-                Err(
-                    e @ (ObjectiveError::NonFinite { .. }
-                    | ObjectiveError::NotPositiveDefinite { .. }),
-                ) => e.to_string(),
-                Err(source) => return Err(TrainError::Objective { step: t, source }),
-            };
-            let Some(prev) = state.prev.as_ref() else {
-                return Err(TrainError::BadStart { step: t, reason });
-            };
-            retry += 1;
-            if retry > config.divergence.max_retries {
-                return Err(TrainError::Diverged {
-                    step: t,
-                    retries: retry - 1,
-                    lr_scale: state.lr_scale,
-                    reason,
-                });
-            }
-            state.rejected += 1;
-            state.lr_scale *= config.divergence.lr_factor;
-            state.params.copy_from_slice(&prev.params);
-            state.adam.copy_from(&prev.adam);
-            state
-                .adam
-                .step(&mut state.params, &prev.grad, prev.lr * state.lr_scale);
-            emit(&TrainEvent::Rejected {
-                step: t,
-                reason,
-                lr_scale: state.lr_scale,
-                retry,
-            });
-        };
+        let loss = accepted_loss(
+            objective,
+            &mut state,
+            config,
+            &batch,
+            seed,
+            t,
+            &mut grad,
+            &mut scratch,
+            &mut emit,
+        )?;
 
         match state.prev.as_mut() {
             Some(p) => {
@@ -672,34 +752,7 @@ pub fn train<O: Objective + ?Sized>(
         if epoch_end {
             let evaluated = (epoch + 1) % config.eval_every == 0 || state.step == total_steps;
             if evaluated {
-                let metrics = match evaluate.as_mut() {
-                    Some(f) => f(&state.params)
-                        .map_err(|message| TrainError::Evaluation { epoch, message })?,
-                    None => Evaluation::default(),
-                };
-                let mean_loss = state.epoch_loss_sum / state.epoch_batches.max(1) as f64;
-                let score = match config.best_by {
-                    BestBy::Rmse => metrics.val_rmse.or(metrics.train_rmse).unwrap_or(mean_loss),
-                    BestBy::TrainingLoss => mean_loss,
-                };
-                let is_best =
-                    score.is_finite() && state.best.as_ref().is_none_or(|b| score < b.score);
-                if is_best {
-                    state.best = Some(BestModel {
-                        params: state.params.clone(),
-                        score,
-                        epoch,
-                    });
-                }
-                state.history.push(EpochRecord {
-                    epoch,
-                    step: state.step,
-                    mean_loss,
-                    train_rmse: metrics.train_rmse,
-                    val_rmse: metrics.val_rmse,
-                    lr,
-                    is_best,
-                });
+                record_epoch(&mut state, config, evaluate.as_mut(), epoch, lr)?;
                 if let Some(rec) = state.history.last() {
                     emit(&TrainEvent::Epoch(rec));
                 }

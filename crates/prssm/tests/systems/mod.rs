@@ -1,5 +1,5 @@
 //! Simulated nonlinear benchmark systems with known dynamics, for testing system
-//! identification end to end.
+//! identification end to end (the engine's tests; not part of its API).
 //!
 //! [`Duffing`]: the forced Duffing oscillator
 //!
@@ -10,6 +10,7 @@
 //! (dimensionless time and position). The input is held constant over each sample period
 //! (zero-order hold) and the state integrated with classical RK4 sub-steps.
 
+use flapssm_prssm::train::bench::random_input;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rand_distr::StandardNormal;
@@ -79,24 +80,6 @@ impl Duffing {
         }
         out
     }
-}
-
-/// Smooth random excitation: Gaussian levels of standard deviation `amplitude`, held for
-/// `hold` samples, passed through a first-order low-pass `ū_t = ū_{t−1} + (u_t − ū_{t−1})/2`.
-pub fn random_input(len: usize, amplitude: f64, hold: usize, seed: u64) -> Vec<f64> {
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let hold = hold.max(1);
-    let mut level = 0.0;
-    let mut smooth = 0.0;
-    (0..len)
-        .map(|t| {
-            if t % hold == 0 {
-                level = amplitude * rng.sample::<f64, _>(StandardNormal);
-            }
-            smooth += 0.5 * (level - smooth);
-            smooth
-        })
-        .collect()
 }
 
 /// Input/output sequences of a simulated system (one input, one output per step).

@@ -1,0 +1,224 @@
+//! The evaluation pipeline against independent computations and its settings' checks.
+
+use super::*;
+use crate::models::Fit;
+use crate::models::arx::checked;
+use crate::models::lrqsm::LrqsmLoadModel;
+use crate::models::prssm::PrssmLoadModel;
+use crate::progress::NoProgress;
+use crate::test_data::tiny_dataset;
+use crate::train::{TrainingOptions, train_prssm};
+use flapssm_analysis::authority::AuthorityConfig;
+use flapssm_qs::arx::ArxSettings;
+use flapssm_wing::cycles::published_window;
+
+/// The pipeline's LRQSM errors agree with the qs crate's own RMSE (computed there from raw
+/// loads divided by σ), and its sums are consistent: overall² = mean of per-output RMSE²,
+/// ratio = PR-SSM / LRQSM, the windows are the published ones.
+#[test]
+fn metrics_agree_with_independent_computations() {
+    let ds = tiny_dataset();
+    let lrqsm =
+        flapssm_qs::lrqsm::fit_dataset(&ds, Default::default(), &Default::default(), "tiny")
+            .unwrap();
+    let q = flapssm_qs::lrqsm::predict_dataset(&lrqsm, &ds, lrqsm.prediction_intercept).unwrap();
+    let opts = TrainingOptions {
+        dx: Some(5),
+        inducing: Some(6),
+        particles: Some(3),
+        epochs: Some(1),
+        val_fraction: 0.0,
+        ..TrainingOptions::default()
+    };
+    let plan = opts.check().unwrap();
+    let fit = train_prssm(ds.train(), &plan, None, None, None, &NoProgress, None).unwrap();
+    let dir = std::env::temp_dir().join(format!("flapssm-pipeline-{}", std::process::id()));
+    let eo = EvalOptions {
+        start_sample: 0,
+        particles: 3,
+        authority: AuthorityConfig {
+            grid_points: 20,
+            ..AuthorityConfig::default()
+        },
+        ..EvalOptions::default()
+    };
+    let prssm = PrssmLoadModel::new(&fit.best, &ds, eo.particles, eo.seed).unwrap();
+    let lq = LrqsmLoadModel::new(&lrqsm).unwrap();
+    let arx = checked(ArxSettings::default())
+        .unwrap()
+        .fit(&ds, &NoProgress)
+        .unwrap();
+    let r = evaluate(
+        &ds,
+        "tiny",
+        &[&prssm, &lq, &arx],
+        &eo,
+        &ReportContext::default(),
+        &dir,
+        &NoProgress,
+    )
+    .unwrap();
+    assert_eq!(
+        r.models.iter().map(|m| m.key.as_str()).collect::<Vec<_>>(),
+        ["prssm", "lrqsm", "arx"]
+    );
+    let (rp, rl) = (r.model("prssm").unwrap(), r.model("lrqsm").unwrap());
+    let lt = rl.test.as_ref().unwrap();
+    let qt = q.rmse_test.as_ref().unwrap();
+    for j in 0..5 {
+        assert!((lt.rmse_standardized[j] - qt.standardized[j]).abs() < 1e-10);
+        assert!(
+            (rl.train.rmse_standardized[j] - q.rmse_train.as_ref().unwrap().standardized[j]).abs()
+                < 1e-10
+        );
+    }
+    let pt = rp.test.as_ref().unwrap();
+    let ms: f64 = pt.rmse_standardized.iter().map(|v| v * v).sum::<f64>() / 5.0;
+    assert!((pt.overall_rmse_standardized - ms.sqrt()).abs() < 1e-12);
+    for j in 0..5 {
+        assert_eq!(
+            r.rmse_ratio[j],
+            pt.rmse_standardized[j] / lt.rmse_standardized[j]
+        );
+    }
+    for (t, m) in ds.trajectories.iter().zip(&r.trajectories) {
+        let stroke: Vec<f64> = t.euler_rad.iter().map(|e| e[0]).collect();
+        let w = published_window(&stroke).unwrap();
+        assert_eq!((m.window_start, m.period_samples), (w.first, w.duration));
+    }
+    // 4 inputs on x1..x5; with D_x 5 there is no x7..x12.
+    assert_eq!(r.authority_findings.len(), 20);
+    // The paper beside us: each endpoint from the report's own numbers.
+    let row = |prefix: &str| {
+        r.paper_comparison
+            .iter()
+            .find(|c| c.endpoint.starts_with(prefix))
+            .unwrap_or_else(|| panic!("no row {prefix}: {:#?}", r.paper_comparison))
+    };
+    let ex = &r.example_trajectories;
+    assert!(!ex.is_empty() && ex.iter().all(|&i| i >= r.n_train));
+    let cfx: Vec<f64> = ex
+        .iter()
+        .map(|&i| r.trajectories[i].models[0].cycle_rmse_cf[0])
+        .collect();
+    let (lo, hi) = (
+        cfx.iter().copied().fold(f64::INFINITY, f64::min),
+        cfx.iter().copied().fold(0.0, f64::max),
+    );
+    let fig3 = row("C_Fx RMSE, PR-SSM");
+    assert!(
+        fig3.flapssm.starts_with(&format!("{lo:.2}–{hi:.2} (")),
+        "{fig3:?}"
+    );
+    assert_eq!(fig3.paper, "0.11–0.21");
+    let bound = pt
+        .error_interval
+        .iter()
+        .map(|i| i.lo.abs().max(i.hi.abs()))
+        .fold(0.0, f64::max);
+    let fig4a = row("95 % error bounds over the 5 outputs (σ), PR-SSM, test");
+    assert!(
+        fig4a.flapssm.ends_with(&format!("–{bound:.2}")),
+        "{fig4a:?}"
+    );
+    let c = &rl.cycle_average_error_interval_all[1];
+    let fig4b = row("95 % interval of half-stroke-average C_Fy errors, LRQSM");
+    assert!(
+        fig4b
+            .flapssm
+            .starts_with(&format!("[{:.2}, {:.2}]", c.lo, c.hi))
+    );
+    assert_eq!(fig4b.paper, "[-0.20, 0.20]");
+    for prefix in [
+        "C_Fy RMSE, LRQSM",
+        "C_Fx RMSE ratio LRQSM / PR-SSM",
+        "C_Fy RMSE ratio LRQSM / PR-SSM",
+        "95 % error bounds over the 5 outputs (σ), LRQSM, training",
+        "AoA → the outputs",
+        "a_x → the outputs",
+        "d²α/dt² → the outputs",
+        "prediction of one trajectory, PR-SSM",
+    ] {
+        row(prefix);
+    }
+    assert!(
+        r.paper_comparison
+            .iter()
+            .all(|c| !c.endpoint.contains("x7"))
+    );
+    assert!(
+        r.prediction_timing
+            .iter()
+            .any(|t| t.model == "prssm" && t.median_ms > 0.0)
+    );
+    let written: EvaluationReport =
+        serde_json::from_slice(&std::fs::read(dir.join("metrics.json")).unwrap()).unwrap();
+    assert_eq!(written.paper_comparison, r.paper_comparison);
+    for f in &r.files {
+        assert!(dir.join(f).exists(), "{f}");
+    }
+    let csv = std::fs::read_to_string(dir.join("trajectories.csv")).unwrap();
+    assert!(csv.lines().next().unwrap().ends_with(
+        "prssm_rmse_cfx,prssm_rmse_cfy,lrqsm_rmse_cfx,lrqsm_rmse_cfy,arx_rmse_cfx,arx_rmse_cfy,\
+         prssm_overall_rmse_std,lrqsm_overall_rmse_std,arx_overall_rmse_std"
+    ));
+    std::fs::remove_dir_all(&dir).ok();
+
+    // One model without latent states: no authority analysis, no Fig. 5, no ratio.
+    let dir = std::env::temp_dir().join(format!("flapssm-one-model-{}", std::process::id()));
+    let r = evaluate(
+        &ds,
+        "tiny",
+        &[&arx],
+        &eo,
+        &ReportContext::default(),
+        &dir,
+        &NoProgress,
+    )
+    .unwrap();
+    assert!(r.authority_findings.is_empty() && r.rmse_ratio.is_empty());
+    assert!(
+        !r.files
+            .iter()
+            .any(|f| f.starts_with("fig5") || f.starts_with("authority"))
+    );
+    for f in &r.files {
+        assert!(dir.join(f).exists(), "{f}");
+    }
+    std::fs::remove_dir_all(&dir).ok();
+    let e = evaluate(
+        &ds,
+        "tiny",
+        &[],
+        &eo,
+        &ReportContext::default(),
+        &dir,
+        &NoProgress,
+    )
+    .unwrap_err();
+    assert!(e.to_string().contains("models to evaluate"), "{e}");
+}
+
+#[test]
+fn evaluation_settings_are_checked_and_named() {
+    let err = |o: EvalOptions| o.check().unwrap_err().to_string();
+    assert!(EvalOptions::default().check().is_ok());
+    let e = err(EvalOptions {
+        particles: 0,
+        ..EvalOptions::default()
+    });
+    assert!(e.contains("setting particles = 0"), "{e}");
+    let e = err(EvalOptions {
+        level: 100.0,
+        ..EvalOptions::default()
+    });
+    assert!(e.contains("setting level = 100"), "{e}");
+    let e = err(EvalOptions {
+        authority: AuthorityConfig {
+            hdr_mass: 1.5,
+            ..AuthorityConfig::default()
+        },
+        ..EvalOptions::default()
+    });
+    assert!(e.contains("authority.hdr_mass"), "{e}");
+}
