@@ -99,6 +99,16 @@ mod tests {
     }
 
     #[test]
+    fn rmse_per_channel_matches_hand_computed_values() {
+        // Two channels: errors (1, 0) on the first, (0, −2) on the second.
+        let y = [1.0, 2.0, 3.0, 4.0];
+        let m = [0.0, 2.0, 3.0, 6.0];
+        let r = rmse_per_channel(&y, &m, 2);
+        assert!((r[0] - 0.5f64.sqrt()).abs() < 1e-15, "{r:?}");
+        assert!((r[1] - 2f64.sqrt()).abs() < 1e-15, "{r:?}");
+    }
+
+    #[test]
     fn mean_std_is_population_std() {
         let ms = MeanStd::of([1.0, 2.0, 3.0, 6.0]);
         assert_eq!(ms.mean, 3.0);

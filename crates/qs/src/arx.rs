@@ -35,8 +35,8 @@ pub enum ArxError {
         /// What it must be.
         expected: String,
     },
-    /// The dataset cannot be fitted (no training outputs).
-    #[error(transparent)]
+    /// The dataset cannot be fitted (no training outputs); worded as the jobs' dataset errors.
+    #[error("dataset: {0}")]
     Dataset(#[from] flapssm_wing::dataset::DatasetError),
     /// The normal equations are not positive definite.
     #[error(

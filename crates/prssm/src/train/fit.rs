@@ -297,9 +297,6 @@ pub enum FitError {
     /// The model file's training record is missing or invalid.
     #[error("model training record: {0}")]
     Record(String),
-    /// An initial state could not be formed.
-    #[error(transparent)]
-    InitialState(#[from] super::initial::InitialStateError),
     /// A prediction from the model's initial-state rule failed.
     #[error(transparent)]
     Prediction(#[from] crate::predict::PredictionError),

@@ -479,8 +479,7 @@ fn start_state(
                     why: format!("{} values, the objective has {n}", ck.state.params.len()),
                 });
             }
-            let state = ck.state;
-            (state, Some(ck.config))
+            (ck.state, Some(ck.config))
         }
         None => {
             if init.len() != n {
