@@ -1,8 +1,9 @@
 //! The single-precision streaming predictor: particles, kernel and products in `float`
-//! (`flapssm_prssm::stream_f32`), for flight computers without a fast double-precision FPU.
+//! (`flapssm_prssm::stream::StreamPredictor<f32>`), for flight computers without a fast
+//! double-precision FPU.
 
 use flapssm_jobs::seed::prediction_seed;
-use flapssm_prssm::stream_f32::StreamPredictorF32;
+use flapssm_prssm::stream::StreamPredictor;
 
 use crate::model::FlapssmModel;
 use crate::status::{FlapssmStatus, fail, guard};
@@ -13,7 +14,7 @@ use flapssm_prssm::ObjectiveError;
 /// resetting allocate nothing.
 #[derive(Debug)]
 pub struct FlapssmSingleStream {
-    stream: StreamPredictorF32,
+    stream: StreamPredictor<f32>,
     dims: (usize, usize),
 }
 
@@ -72,7 +73,8 @@ pub unsafe extern "C" fn flapssm_single_stream_new(
         if let Err(e) = flapssm_jobs::resources::check_prediction(&m.config, particles, 1, 0.0) {
             return fail(FlapssmStatus::InvalidValue, e.to_string());
         }
-        match StreamPredictorF32::new(m, particles, prediction_seed(seed, 0)) {
+        let zero = vec![0.0; m.config.n_state];
+        match StreamPredictor::new(m, particles, &zero, &zero, prediction_seed(seed, 0)) {
             Ok(stream) => {
                 let dims = (m.config.n_input, m.config.n_output);
                 let handle = Box::into_raw(Box::new(FlapssmSingleStream { stream, dims }));

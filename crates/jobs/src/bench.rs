@@ -4,7 +4,7 @@
 
 use flapssm_prssm::Precision;
 use flapssm_prssm::train::bench::{
-    REFERENCE_SOLVE_S, gemm_rate_gflops, initial_model, predict_step_f32_flops, predict_step_flops,
+    REFERENCE_SOLVE_S, gemm_rate_gflops, initial_model, predict_step_flops,
     reference_solve_seconds, synthetic_objective, time_batches, time_prediction, time_stream_step,
     train_step_f32_flops, train_step_flops,
 };
@@ -33,7 +33,8 @@ pub struct BenchSettings {
     pub reps: usize,
     /// Seed of the synthetic data and parameters.
     pub seed: u64,
-    /// Arithmetic of the training products.
+    /// Arithmetic of the training products; with [`Precision::Mixed`] prediction and
+    /// streaming are timed in `f32` (their step has no mixed form).
     pub precision: Precision,
     /// Windows per parallel task of the timed minibatches ([`FitSpec::windows_per_task`]).
     pub windows_per_task: usize,
@@ -66,7 +67,8 @@ pub struct BenchReport {
     pub gemm_f32_gflops: f64,
     /// Share of the training FLOP that the timed precision runs in `f32` (0 for `f64`).
     pub train_f32_share: f64,
-    /// Share of the prediction FLOP that the timed precision runs in `f32` (0 for `f64`).
+    /// Share of the prediction FLOP run in `f32`: 1 with [`Precision::Mixed`] (the `f32`
+    /// step), 0 for `f64`.
     pub predict_f32_share: f64,
     /// prssm-notes §4's triangular solve (100 × 100, 480 right-hand sides, one thread), s.
     pub reference_solve_s: f64,
@@ -105,6 +107,25 @@ impl BenchReport {
     pub fn precision_flop_limit_predict_s(&self) -> f64 {
         let gflop = self.predict_s * self.predict_gflops;
         gflop * self.seconds_per_gflop(self.predict_f32_share)
+    }
+
+    /// The arithmetic prediction and streaming were timed in: `"f32"` under
+    /// [`Precision::Mixed`], else `"f64"`.
+    pub fn prediction_float(&self) -> &'static str {
+        if self.precision == Precision::Mixed {
+            "f32"
+        } else {
+            "f64"
+        }
+    }
+
+    /// The one-thread GEMM rate in [`Self::prediction_float`], GFLOP/s.
+    pub fn prediction_gemm_gflops(&self) -> f64 {
+        if self.precision == Precision::Mixed {
+            self.gemm_f32_gflops
+        } else {
+            self.gemm_gflops
+        }
     }
 
     /// Seconds one core takes per GFLOP at the GEMM rates when `f32_share` of the FLOP run
@@ -159,27 +180,27 @@ pub fn bench(settings: &BenchSettings) -> Result<BenchReport> {
         .map_err(|e| engine("timing training batches", e.into()))?;
     let per_epoch = BATCHES_PER_EPOCH as f64 / settings.batches as f64;
     let model = initial_model(&spec, settings.seed);
-    let predict_s = time_prediction(
-        &model,
-        PREDICT_STEPS,
-        spec.particles,
-        settings.reps,
-        settings.precision,
-    )
+    let mixed = settings.precision == Precision::Mixed;
+    let (particles, reps) = (spec.particles, settings.reps);
+    let predict_s = if mixed {
+        time_prediction::<f32>(&model, PREDICT_STEPS, particles, reps)
+    } else {
+        time_prediction::<f64>(&model, PREDICT_STEPS, particles, reps)
+    }
     .map_err(|e| engine("timing prediction", e.into()))?;
     let step_flops = predict_step_flops(&model.config, spec.particles);
-    let stream_step_s = time_stream_step(&model, spec.particles, 2000, settings.precision)
-        .map_err(|e| engine("timing streaming", e.into()))?;
-    let mixed = settings.precision == Precision::Mixed;
+    let stream_step_s = if mixed {
+        time_stream_step::<f32>(&model, particles, 2000)
+    } else {
+        time_stream_step::<f64>(&model, particles, 2000)
+    }
+    .map_err(|e| engine("timing streaming", e.into()))?;
     let share = |part: f64, all: f64| if mixed { part / all } else { 0.0 };
     let train_f32_share = share(
         train_step_f32_flops(&spec.model, spec.particles),
         train_step_flops(&spec.model, spec.particles),
     );
-    let predict_f32_share = share(
-        predict_step_f32_flops(&model.config, spec.particles),
-        step_flops,
-    );
+    let predict_f32_share = share(1.0, 1.0);
     Ok(BenchReport {
         precision: settings.precision,
         windows_per_task: settings.windows_per_task,

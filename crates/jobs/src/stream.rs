@@ -3,7 +3,7 @@
 //!
 //! [`LoadStream`] starts from `x₀ = 0` with the draws of [`prediction_seed`]`(seed, 0)`, exactly
 //! as [`crate::predict::predict_inputs`]: both advance the particles through the engine's one
-//! step (`flapssm_prssm::predict::StepPredictor`), so streaming a table gives the batch
+//! step (`flapssm_prssm::step::ParticleStep`), so streaming a table gives the batch
 //! prediction draw for draw. [`stream_csv`] reads input rows as they arrive and writes each
 //! prediction row at once (flushed), in the format of `flapssm predict --inputs`.
 //!

@@ -4,13 +4,13 @@
 //! step over the paper's parameter vector.
 
 use criterion::{BenchmarkId, Criterion, black_box, criterion_group, criterion_main};
+use flapssm_prssm::Objective;
 use flapssm_prssm::stream::StreamPredictor;
 use flapssm_prssm::train::Adam;
 use flapssm_prssm::train::bench::{
     initial_model, synthetic_objective, time_batches, time_prediction,
 };
 use flapssm_prssm::train::fit::{FitSpec, Preset};
-use flapssm_prssm::{Objective, Precision};
 
 fn benches(c: &mut Criterion) {
     let mut g = c.benchmark_group("train");
@@ -36,7 +36,7 @@ fn benches(c: &mut Criterion) {
     );
     let model = initial_model(&spec, 0);
     g.bench_with_input(BenchmarkId::new("predict_470x30", 470), &470, |b, _| {
-        b.iter(|| time_prediction(&model, 470, 30, 1, Precision::F64).unwrap())
+        b.iter(|| time_prediction::<f64>(&model, 470, 30, 1).unwrap())
     });
     let mut stream = StreamPredictor::new(&model, 30, &[0.0; 12], &[0.0; 12], 0).unwrap();
     let u = [0.1, -0.3, 0.2, 0.5, -0.1, 0.0, 0.3];

@@ -224,17 +224,6 @@ pub(crate) fn cross_cov_grouped(
     }
 }
 
-/// Forward-only [`cross_cov_grouped`]: `K` without the derivative (prediction).
-pub(crate) fn cross_cov_grouped_values(p: GroupedPoints, k: &mut [f64], tau_shared: &mut [f64]) {
-    let (m_n, group) = (p.m(), p.group);
-    let tau_shared = &mut tau_shared[..m_n];
-    for (kg, xg) in k.chunks_mut(m_n * group).zip(p.xs.chunks(p.d * group)) {
-        p.group_tau(xg, tau_shared, kg);
-        // Over the whole group: one vector loop without per-column scalar tails.
-        apply_shape_values(p.kind, p.variance, p.tau_jitter, kg);
-    }
-}
-
 /// [`cross_cov_grouped`] with the shape in `f32`, for the products of mixed precision
 /// ([`crate::precision`]): `τ` in `f64` into `tau` (`M × N`), then `k32 = σ_f² g(τ)` by
 /// [`exp_f32`] and the `f32` square root, as product operands (values below
@@ -347,24 +336,6 @@ fn apply_shape(kind: KernelKind, variance: f64, jitter: f64, k: &mut [f64], kd: 
                 let g = variance * exp(-0.5 * *kv);
                 *kv = g;
                 *kdv = -0.5 * g;
-            }
-        }
-    }
-}
-
-/// Replaces `τ` in `k` by `σ_f² g(τ)` (no derivative).
-#[inline]
-fn apply_shape_values(kind: KernelKind, variance: f64, jitter: f64, k: &mut [f64]) {
-    match kind {
-        KernelKind::Matern32 => {
-            for kv in k.iter_mut() {
-                let r = (3.0 * (*kv + jitter)).sqrt();
-                *kv = (1.0 + r) * (variance * exp(-r));
-            }
-        }
-        KernelKind::SquaredExponential => {
-            for kv in k.iter_mut() {
-                *kv = variance * exp(-0.5 * *kv);
             }
         }
     }

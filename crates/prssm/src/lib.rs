@@ -23,8 +23,9 @@
 //!   [`Elbo::with_precision`]`(`[`Precision::Mixed`]`)` forms the large products in `f32`
 //!   ([`precision`]).
 //! - [`predict::predict`] / [`predict::predict_with_draws`]: open-loop particle simulation
-//!   ([`predict::Prediction`]); [`predict::StepPredictor`]: one step at a time on caller
-//!   buffers, no allocation per step.
+//!   ([`predict::Prediction`]); [`stream::StreamPredictor`]: one input sample at a time, no
+//!   allocation per step. Both advance the particles with one step,
+//!   [`step::ParticleStep`], in `f64` or `f32` ([`step::StepFloat`]).
 //! - [`PrssmModel`]: config + params + normalization + training settings; JSON file
 //!   ([`PrssmModel::save`], [`PrssmModel::load`]); [`published::import_published`]; prediction
 //!   in physical units from the model's initial-state rule ([`PrssmModel::predict_sequence`],
@@ -43,8 +44,8 @@ pub mod params;
 pub mod precision;
 pub mod predict;
 pub mod published;
+pub mod step;
 pub mod stream;
-pub mod stream_f32;
 mod tape;
 pub mod train;
 

@@ -33,10 +33,8 @@
 //! `f32` kernels several times slower than the `f64` ones (a streaming step: 60 µs against
 //! 26 µs before the floor, 22 µs after).
 //!
-//! Prediction and streaming take the same choice (`StepPredictor::with_precision`,
-//! `predict::predict_with_precision`, `StreamPredictor::with_precision`): the forward product
-//! `[W; μ] = [G; mᵀG] K`, `S(W⊙W)` and the kernel's shape in `f32`, `τ` and the variance's
-//! cancellation in `f64`; a variance that the rounding takes below zero counts as zero there.
+//! Prediction does not take this choice: its one step ([`crate::step::ParticleStep`]) runs
+//! wholly in `f64` or wholly in `f32`.
 //!
 //! [`Precision::F64`] is the reference; `tests/mixed_precision.rs` measures the difference.
 

@@ -4,16 +4,16 @@
 //! Reported moments (as the published code): particle mean, particle variance divided by
 //! `P` (not `P − 1`), plus `σ_y²` for outputs and `σ_x²` for latent states.
 
-use rand::{Rng, SeedableRng};
+use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
 use serde::{Deserialize, Serialize};
 
-use crate::conditional::{Posterior, PredictiveWorkspace};
+use crate::conditional::Posterior;
 use crate::elbo::SequenceView;
 use crate::objective::ObjectiveError;
 use crate::params::{ModelConfig, Params};
-use crate::precision::Precision;
+use crate::step::{ParticleStep, StepFloat};
 use crate::train::initial::{InitialStateError, InitialStateModel};
 
 /// Predictive moments over `T` steps.
@@ -91,103 +91,10 @@ pub fn predict_standardized(
     )?)
 }
 
-/// One transition step for `P` particles on caller buffers (for streaming prediction).
-#[derive(Debug, Clone)]
-pub struct StepPredictor {
-    post: Posterior,
-    ws: PredictiveWorkspace,
-    particles: usize,
-    dx: usize,
-    du: usize,
-    process_noise_var: Vec<f64>,
-    jitter: f64,
-    shared_draws: bool,
-}
-
-impl StepPredictor {
-    /// This predictor with its conditional's large products in `precision`
-    /// ([`Precision::Mixed`]: `[G; mᵀG] K` and `S(W⊙W)` in `f32`, see [`crate::precision`];
-    /// a variance that the `f32` rounding takes below zero counts as zero).
-    pub fn with_precision(mut self, precision: Precision) -> Self {
-        self.post.set_precision(precision);
-        self.ws = PredictiveWorkspace::new(&self.post, self.particles, self.particles);
-        self
-    }
-
-    /// Prepares the conditional (factorizes `K_mm`) and buffers for `particles` particles.
-    ///
-    /// # Errors
-    /// [`ObjectiveError`] on invalid parameters or a non-positive-definite `K_mm`.
-    pub fn new(
-        config: &ModelConfig,
-        params: &Params,
-        particles: usize,
-    ) -> Result<Self, ObjectiveError> {
-        let post = prediction_posterior(config, params, particles)?;
-        // All particles share the input of a step.
-        let ws = PredictiveWorkspace::new(&post, particles, particles);
-        Ok(Self {
-            post,
-            ws,
-            particles,
-            dx: config.n_state,
-            du: config.n_input,
-            process_noise_var: params.process_noise_var.clone(),
-            jitter: config.transition_jitter,
-            shared_draws: config.shared_draws,
-        })
-    }
-
-    /// Number of particles.
-    pub fn particles(&self) -> usize {
-        self.particles
-    }
-
-    /// Fills `eps` (`D_x × P`, column-major) with standard-normal draws; with shared draws
-    /// (published compat) one draw per particle is copied to all dims.
-    pub fn draw(&self, rng: &mut impl Rng, eps: &mut [f64]) {
-        StepDraws {
-            dx: self.dx,
-            shared: self.shared_draws,
-        }
-        .fill(rng, eps);
-    }
-
-    /// Advances the particles `x` (`D_x × P`, column-major) by one step under input `u`
-    /// (`D_u`) with draws `eps` (`D_x × P`), in place. Allocates nothing.
-    pub fn step(&mut self, x: &mut [f64], u: &[f64], eps: &[f64]) {
-        let (dx, du) = (self.dx, self.du);
-        let d = dx + du;
-        for c in 0..self.particles {
-            self.ws.input[c * d..c * d + dx].copy_from_slice(&x[c * dx..(c + 1) * dx]);
-            self.ws.input[c * d + dx..(c + 1) * d].copy_from_slice(&u[..du]);
-        }
-        self.ws.forward(&self.post, self.particles);
-        let (vx, jit) = (&self.process_noise_var, self.jitter);
-        // Only the f32 products can take σ² below zero by more than σ_x² + δ covers.
-        let floor = match self.post.precision() {
-            Precision::F64 => f64::NEG_INFINITY,
-            Precision::Mixed => 0.0,
-        };
-        for (c, ((x, var), e)) in x
-            .chunks_exact_mut(dx)
-            .zip(self.ws.var.chunks_exact(dx))
-            .zip(eps.chunks_exact(dx))
-            .take(self.particles)
-            .enumerate()
-        {
-            let mean = self.ws.mean(&self.post, c);
-            for dd in 0..dx {
-                x[dd] += mean[dd] + (var[dd].max(floor) + vx[dd] + jit).sqrt() * e[dd];
-            }
-        }
-    }
-}
-
 /// Particle mean and variance (divided by `P`) of `x` (`P × D_x`) at step `t`, plus the
 /// noise variances. The sums over particles run in particle order for all dims at once.
-fn moments(
-    x: &[f64],
+fn moments<T: StepFloat>(
+    x: &[T],
     dx: usize,
     dy: usize,
     vx: &[f64],
@@ -199,7 +106,7 @@ fn moments(
     let mean = &mut out.latent_mean[t * dx..(t + 1) * dx];
     mean.fill(0.0);
     for c in x.chunks_exact(dx) {
-        mean.iter_mut().zip(c).for_each(|(m, &v)| *m += v);
+        mean.iter_mut().zip(c).for_each(|(m, &v)| *m += v.to_f64());
     }
     mean.iter_mut().for_each(|m| *m /= p);
     let var = &mut out.latent_var[t * dx..(t + 1) * dx];
@@ -208,7 +115,7 @@ fn moments(
         var.iter_mut()
             .zip(c)
             .zip(mean.iter())
-            .for_each(|((s, &v), &m)| *s += (v - m) * (v - m));
+            .for_each(|((s, &v), &m)| *s += (v.to_f64() - m) * (v.to_f64() - m));
     }
     for dd in 0..dx {
         let v = var[dd] / p;
@@ -262,7 +169,7 @@ pub fn simulate_with_draws(
             t_n - 1
         )));
     }
-    let mut sp = StepPredictor::new(config, params, np)?;
+    let mut sp = ParticleStep::<f64>::new(config, params, np)?;
     let step = np * dx;
     let mut all = vec![0.0; t_n * step];
     all[..step].copy_from_slice(x0);
@@ -351,32 +258,23 @@ pub fn predict(
     seed: u64,
 ) -> Result<Prediction, ObjectiveError> {
     let init = (init_mean, init_std);
-    let run = (particles, seed, Precision::F64);
-    run_prediction(config, params, inputs, init, run, None)
+    run_prediction::<f64>(config, params, inputs, init, (particles, seed), None)
 }
 
-/// [`predict`] with the conditional's large products in `precision`
-/// ([`StepPredictor::with_precision`]); `Precision::F64` is [`predict`].
+/// [`predict`] with the step in `T` ([`ParticleStep`]; `f64` is [`predict`]): the same draws,
+/// rounded to `T`; the moments summed in `f64`.
 ///
 /// # Errors
 /// As [`predict`].
-pub fn predict_with_precision(
+pub fn predict_in<T: StepFloat>(
     config: &ModelConfig,
     params: &Params,
     inputs: &[f64],
     init: (&[f64], &[f64]),
     particles: usize,
     seed: u64,
-    precision: Precision,
 ) -> Result<Prediction, ObjectiveError> {
-    run_prediction(
-        config,
-        params,
-        inputs,
-        init,
-        (particles, seed, precision),
-        None,
-    )
+    run_prediction::<T>(config, params, inputs, init, (particles, seed), None)
 }
 
 /// [`predict`] that also returns every particle, `T × P × D_x` row-major (standardized latent
@@ -395,19 +293,25 @@ pub fn predict_particles(
     let t_n = inputs.len().checked_div(config.n_input).unwrap_or(1).max(1);
     let mut all = vec![0.0; t_n * particles * config.n_state];
     let init = (init_mean, init_std);
-    let run = (particles, seed, Precision::F64);
-    let p = run_prediction(config, params, inputs, init, run, Some(&mut all))?;
+    let p = run_prediction::<f64>(
+        config,
+        params,
+        inputs,
+        init,
+        (particles, seed),
+        Some(&mut all),
+    )?;
     Ok((p, all))
 }
 
-/// The prediction loop of [`predict`] with `(particles, seed, precision)`, copying the
-/// particles of every step into `keep` (`T × P × D_x`) when given.
-fn run_prediction(
+/// The prediction loop of [`predict`] in `T` with `(particles, seed)`, copying the particles
+/// of every step into `keep` (`T × P × D_x`) when given.
+fn run_prediction<T: StepFloat>(
     config: &ModelConfig,
     params: &Params,
     inputs: &[f64],
     (init_mean, init_std): (&[f64], &[f64]),
-    (particles, seed, precision): (usize, u64, Precision),
+    (particles, seed): (usize, u64),
     mut keep: Option<&mut [f64]>,
 ) -> Result<Prediction, ObjectiveError> {
     let (dx, du, dy) = (config.n_state, config.n_input, config.n_output);
@@ -423,53 +327,36 @@ fn run_prediction(
         )));
     }
     let t_n = inputs.len().checked_div(du).unwrap_or(1);
-    let mut sp = StepPredictor::new(config, params, particles)?.with_precision(precision);
+    let mut sp = ParticleStep::<T>::new(config, params, particles)?;
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let mut x = vec![0.0; particles * dx];
+    let mut x = vec![T::of(0.0); particles * dx];
     for c in x.chunks_exact_mut(dx) {
         for d in 0..dx {
             let e: f64 = StandardNormal.sample(&mut rng);
-            c[d] = init_mean[d] + init_std[d] * e;
+            c[d] = T::of(init_mean[d] + init_std[d] * e);
         }
     }
     let (vx, vy) = (&params.process_noise_var, &params.obs_noise_var);
     let mut pred = empty_prediction(t_n, dx, dy);
-    let mut record = |t: usize, x: &[f64]| {
+    let mut record = |t: usize, x: &[T]| {
         if let Some(k) = keep.as_deref_mut() {
-            k[t * x.len()..(t + 1) * x.len()].copy_from_slice(x);
+            let row = &mut k[t * x.len()..(t + 1) * x.len()];
+            row.iter_mut().zip(x).for_each(|(k, &v)| *k = v.to_f64());
         }
     };
     moments(&x, dx, dy, vx, vy, &mut pred, 0);
     record(0, &x);
     let mut eps = vec![0.0; particles * dx];
+    let mut u = vec![T::of(0.0); du];
     for t in 0..t_n - 1 {
         sp.draw(&mut rng, &mut eps);
-        sp.step(&mut x, &inputs[t * du..(t + 1) * du], &eps);
+        let row = &inputs[t * du..(t + 1) * du];
+        u.iter_mut().zip(row).for_each(|(u, &v)| *u = T::of(v));
+        sp.step(&mut x, &u, &eps);
         moments(&x, dx, dy, vx, vy, &mut pred, t + 1);
         record(t + 1, &x);
     }
     Ok(pred)
-}
-
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct StepDraws {
-    pub(crate) dx: usize,
-    pub(crate) shared: bool,
-}
-
-impl StepDraws {
-    pub(crate) fn fill(&self, rng: &mut impl Rng, eps: &mut [f64]) {
-        for e in eps.chunks_exact_mut(self.dx) {
-            if self.shared {
-                let v: f64 = StandardNormal.sample(rng);
-                e.fill(v);
-            } else {
-                for v in e.iter_mut() {
-                    *v = StandardNormal.sample(rng);
-                }
-            }
-        }
-    }
 }
 
 impl Prediction {

@@ -1,13 +1,17 @@
 //! Streaming prediction: one input sample in, the output's predictive mean and variance out,
-//! with no allocation per step.
+//! with no allocation per step, in `f64` or `f32` (`StreamPredictor<f32>`: the particles, the
+//! kernel, the products and the moments in single precision, for flight computers whose FPU
+//! has no fast double precision; the factorization still done once in `f64`).
 //!
 //! At call `t` the predictor reports the moments of `y_t` from the particles `x_t`
 //! (mean over particles; variance over particles divided by `P`, plus `σ_y²`, as
 //! [`predict`](crate::predict::predict)) and then advances the particles with `u_t`:
 //! `x_{t+1} = x_t + μ(x_t, u_t) + √(σ²(x_t, u_t) + σ_x² + δ_t) ⊙ ε_t`. Feeding `u_0, u_1, …`
-//! reproduces the batch prediction exactly, draw for draw, for the same seed: the initial
-//! draws `ε₀` (`P × D_x`) come first from `ChaCha8Rng::seed_from_u64(seed)`, then one block of
-//! `P × D_x` per step.
+//! reproduces the batch prediction exactly, draw for draw, for the same seed: both advance
+//! the particles with [`ParticleStep`]; the initial draws `ε₀` (`P × D_x`) come first from
+//! `ChaCha8Rng::seed_from_u64(seed)`, then one block of `P × D_x` per step (`f64` normals in
+//! either precision). The difference of the `f32` stream from the `f64` one is measured by the
+//! tests and `docs/c-api.md`.
 //!
 //! Units: with a model normalization, inputs and outputs are raw (physical) units; the
 //! initial state `N(m₀, diag s₀²)` is in the model's standardized latent units.
@@ -32,24 +36,24 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
 
-use crate::model::{Normalization, PrssmModel};
+use crate::model::PrssmModel;
 use crate::objective::ObjectiveError;
-use crate::precision::Precision;
-use crate::predict::StepPredictor;
+use crate::step::{ParticleStep, StepFloat, rounded};
 
-/// A particle predictor advanced one input sample at a time (see the module docs).
+/// A particle predictor advanced one input sample at a time, in `T` (see the module docs).
 #[derive(Debug, Clone)]
-pub struct StreamPredictor {
-    step: StepPredictor,
+pub struct StreamPredictor<T: StepFloat = f64> {
+    step: ParticleStep<T>,
     rng: ChaCha8Rng,
     /// Particles, `P × D_x` row-major (particle-major).
-    x: Vec<f64>,
+    x: Vec<T>,
     eps: Vec<f64>,
-    u_z: Vec<f64>,
-    out_mean: Vec<f64>,
-    out_var: Vec<f64>,
-    obs_noise_var: Vec<f64>,
-    norm: Option<Normalization>,
+    u_z: Vec<T>,
+    out_mean: Vec<T>,
+    out_var: Vec<T>,
+    obs_noise_var: Vec<T>,
+    /// `(input mean, input std, output mean, output std)`.
+    norm: Option<[Vec<T>; 4]>,
     dx: usize,
     dy: usize,
     du: usize,
@@ -60,7 +64,7 @@ pub struct StreamPredictor {
     init_std: Vec<f64>,
 }
 
-impl StreamPredictor {
+impl<T: StepFloat> StreamPredictor<T> {
     /// A predictor with `particles` particles started from `N(init_mean, diag init_std²)`
     /// (`D_x` each, standardized latent units), draws seeded by `seed`.
     ///
@@ -81,7 +85,7 @@ impl StreamPredictor {
                 init_std.len()
             )));
         }
-        let step = StepPredictor::new(&model.config, &model.params, particles)?;
+        let step = ParticleStep::new(&model.config, &model.params, particles)?;
         let init = (init_mean.to_vec(), init_std.to_vec());
         Ok(Self::assemble(model, step, particles, seed, init, false))
     }
@@ -99,21 +103,14 @@ impl StreamPredictor {
                 init_mean.len()
             )));
         }
-        let step = StepPredictor::new(&model.config, &model.params, 1)?;
+        let step = ParticleStep::new(&model.config, &model.params, 1)?;
         let init = (init_mean.to_vec(), vec![0.0; dx]);
         Ok(Self::assemble(model, step, 1, 0, init, true))
     }
 
-    /// This predictor with its conditional's large products in `precision`
-    /// ([`StepPredictor::with_precision`]); the draws are unchanged.
-    pub fn with_precision(mut self, precision: Precision) -> Self {
-        self.step = self.step.with_precision(precision);
-        self
-    }
-
     fn assemble(
         model: &PrssmModel,
-        step: StepPredictor,
+        step: ParticleStep<T>,
         particles: usize,
         seed: u64,
         (init_mean, init_std): (Vec<f64>, Vec<f64>),
@@ -121,16 +118,25 @@ impl StreamPredictor {
     ) -> Self {
         let c = &model.config;
         let n = particles * c.n_state;
+        let zero = T::of(0.0);
+        let norm = model.normalization.as_ref().map(|n| {
+            [
+                rounded(&n.input_mean),
+                rounded(&n.input_std),
+                rounded(&n.output_mean),
+                rounded(&n.output_std),
+            ]
+        });
         let mut stream = Self {
             step,
             rng: ChaCha8Rng::seed_from_u64(seed),
             eps: vec![0.0; n],
-            x: vec![0.0; n],
-            u_z: vec![0.0; c.n_input],
-            out_mean: vec![0.0; c.n_output],
-            out_var: vec![0.0; c.n_output],
-            obs_noise_var: model.params.obs_noise_var.clone(),
-            norm: model.normalization.clone(),
+            x: vec![zero; n],
+            u_z: vec![zero; c.n_input],
+            out_mean: vec![zero; c.n_output],
+            out_var: vec![zero; c.n_output],
+            obs_noise_var: rounded(&model.params.obs_noise_var),
+            norm,
             dx: c.n_state,
             dy: c.n_output,
             du: c.n_input,
@@ -154,13 +160,13 @@ impl StreamPredictor {
                 } else {
                     StandardNormal.sample(&mut self.rng)
                 };
-                *x = m + s * e;
+                *x = T::of(m + s * e);
             }
         }
     }
 
     /// Current particles, `P × D_x` row-major (standardized latent units).
-    pub fn particles(&self) -> &[f64] {
+    pub fn particles(&self) -> &[T] {
         &self.x
     }
 
@@ -170,7 +176,7 @@ impl StreamPredictor {
     /// # Errors
     /// [`ObjectiveError::Shape`] when `u` does not have `D_u` values;
     /// [`ObjectiveError::NonFinite`] for a non-finite input.
-    pub fn step(&mut self, u: &[f64]) -> Result<(&[f64], &[f64]), ObjectiveError> {
+    pub fn step(&mut self, u: &[T]) -> Result<(&[T], &[T]), ObjectiveError> {
         if u.len() != self.du {
             return Err(ObjectiveError::Shape(format!(
                 "input has {} values, expected {}",
@@ -178,26 +184,15 @@ impl StreamPredictor {
                 self.du
             )));
         }
-        if u.iter().any(|v| !v.is_finite()) {
+        if u.iter().any(|v| !v.to_f64().is_finite()) {
             return Err(ObjectiveError::NonFinite { what: "input" });
         }
-        let (dx, dy) = (self.dx, self.dy);
-        let p = (self.x.len() / dx) as f64;
-        for dd in 0..dy {
-            let mean = self.x.chunks_exact(dx).map(|c| c[dd]).sum::<f64>() / p;
-            let var = self
-                .x
-                .chunks_exact(dx)
-                .map(|c| (c[dd] - mean).powi(2))
-                .sum::<f64>()
-                / p;
-            self.out_mean[dd] = mean;
-            self.out_var[dd] = var + self.obs_noise_var[dd];
-        }
+        self.moments();
         match &self.norm {
-            Some(n) => {
-                n.standardize_inputs_into(u, &mut self.u_z);
-                n.outputs_to_physical(&mut self.out_mean, &mut self.out_var);
+            Some([im, is, _, _]) => {
+                for (i, (z, &v)) in self.u_z.iter_mut().zip(u).enumerate() {
+                    *z = (v - im[i]) / is[i];
+                }
             }
             None => self.u_z.copy_from_slice(u),
         }
@@ -206,5 +201,29 @@ impl StreamPredictor {
         }
         self.step.step(&mut self.x, &self.u_z, &self.eps);
         Ok((&self.out_mean, &self.out_var))
+    }
+
+    /// Particle mean and variance (divided by `P`) of the outputs, plus `σ_y²`, in the
+    /// model's output units: means `m · std + mean`, variances `v · std²`.
+    fn moments(&mut self) {
+        let (dx, dy) = (self.dx, self.dy);
+        let p = T::of((self.x.len() / dx) as f64);
+        for dd in 0..dy {
+            let mean = self.x.chunks_exact(dx).map(|c| c[dd]).sum::<T>() / p;
+            let var = self
+                .x
+                .chunks_exact(dx)
+                .map(|c| (c[dd] - mean) * (c[dd] - mean))
+                .sum::<T>()
+                / p;
+            self.out_mean[dd] = mean;
+            self.out_var[dd] = var + self.obs_noise_var[dd];
+        }
+        if let Some([_, _, om, os]) = &self.norm {
+            for dd in 0..dy {
+                self.out_mean[dd] = self.out_mean[dd] * os[dd] + om[dd];
+                self.out_var[dd] *= os[dd] * os[dd];
+            }
+        }
     }
 }

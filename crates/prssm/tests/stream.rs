@@ -119,12 +119,8 @@ fn a_streaming_step_does_not_allocate() {
     let u = inputs(50, 7);
     let mut stream = StreamPredictor::new(&model, 30, &[0.0; 12], &[0.0; 12], 1).unwrap();
     let mut mean_stream = StreamPredictor::mean_propagated(&model, &[0.0; 12]).unwrap();
-    let mut mixed = StreamPredictor::new(&model, 30, &[0.0; 12], &[0.0; 12], 1)
-        .unwrap()
-        .with_precision(flapssm_prssm::Precision::Mixed);
     stream.step(&u[..7]).unwrap();
     mean_stream.step(&u[..7]).unwrap();
-    mixed.step(&u[..7]).unwrap();
     let before = allocations();
     let mut acc = 0.0;
     for t in 1..50 {
@@ -132,12 +128,9 @@ fn a_streaming_step_does_not_allocate() {
         acc += m[0] + v[0];
         let (m, _) = mean_stream.step(&u[t * 7..(t + 1) * 7]).unwrap();
         acc += m[0];
-        let (m, v) = mixed.step(&u[t * 7..(t + 1) * 7]).unwrap();
-        acc += m[0] + v[0];
     }
     stream.reset();
     mean_stream.reset();
-    mixed.reset();
     let after = allocations();
     assert!(acc.is_finite());
     assert_eq!(after - before, 0, "allocations during 147 streaming steps");
@@ -175,7 +168,6 @@ fn reset_repeats_the_stream_from_its_first_draws() {
 fn the_single_precision_stream_follows_the_double_precision_one() {
     use flapssm_prssm::KernelKind;
     use flapssm_prssm::params::{CovarianceStructure, Parametrization};
-    use flapssm_prssm::stream_f32::StreamPredictorF32;
     let mut worst = 0.0f64;
     for kernel in [KernelKind::Matern32, KernelKind::SquaredExponential] {
         for cov in [CovarianceStructure::Diagonal, CovarianceStructure::Full] {
@@ -196,7 +188,8 @@ fn the_single_precision_stream_follows_the_double_precision_one() {
                     );
                     let u = inputs(200, 3);
                     let mut s64 = StreamPredictor::new(&m, 20, &[0.0; 6], &[0.0; 6], 9).unwrap();
-                    let mut s32 = StreamPredictorF32::new(&m, 20, 9).unwrap();
+                    let mut s32 =
+                        StreamPredictor::<f32>::new(&m, 20, &[0.0; 6], &[0.0; 6], 9).unwrap();
                     for t in 0..200 {
                         let ut = &u[t * 3..t * 3 + 3];
                         let u32: Vec<f32> = ut.iter().map(|&v| v as f32).collect();
@@ -217,7 +210,8 @@ fn the_single_precision_stream_follows_the_double_precision_one() {
                         }
                     }
                     // A reset repeats the stream from its first draws.
-                    let mut fresh = StreamPredictorF32::new(&m, 20, 9).unwrap();
+                    let mut fresh =
+                        StreamPredictor::<f32>::new(&m, 20, &[0.0; 6], &[0.0; 6], 9).unwrap();
                     s32.reset();
                     for t in 0..5 {
                         let u32: Vec<f32> = u[t * 3..t * 3 + 3].iter().map(|&v| v as f32).collect();
@@ -235,7 +229,7 @@ fn the_single_precision_stream_follows_the_double_precision_one() {
 fn a_single_precision_step_does_not_allocate() {
     let model = model(12, 5, 7, 100, false);
     let u: Vec<f32> = inputs(50, 7).iter().map(|&v| v as f32).collect();
-    let mut stream = flapssm_prssm::stream_f32::StreamPredictorF32::new(&model, 30, 1).unwrap();
+    let mut stream = StreamPredictor::<f32>::new(&model, 30, &[0.0; 12], &[0.0; 12], 1).unwrap();
     stream.step(&u[..7]).unwrap();
     let before = allocations();
     let mut acc = 0.0;

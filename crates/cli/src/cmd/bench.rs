@@ -182,22 +182,23 @@ pub fn run(args: BenchArgs) -> anyhow::Result<()> {
         r.fastest_epoch_s
     );
     println!(
-        "prediction (470 steps x 30 particles, 1 thread, {} precision): {:.3} ms, {:.1} GFLOP/s ({:.0} % of the f64 GEMM rate), \
+        "prediction (470 steps x 30 particles, 1 thread, in {}): {:.3} ms, {:.1} GFLOP/s ({:.0} % of the {} GEMM rate), \
          the authors' code {AUTHORS_PREDICT_S} s on their machine, not this one: {:.1}x",
-        r.precision,
+        r.prediction_float(),
         r.predict_s * 1e3,
         r.predict_gflops,
-        100.0 * r.predict_gflops / r.gemm_gflops,
+        100.0 * r.predict_gflops / r.prediction_gemm_gflops(),
+        r.prediction_float(),
         AUTHORS_PREDICT_S / r.predict_s
     );
     println!(
-        "  all FLOP at the GEMM rate of their precision ({:.0} % in f32): {:.2} ms",
-        100.0 * r.predict_f32_share,
+        "  all FLOP at the {} GEMM rate: {:.2} ms",
+        r.prediction_float(),
         r.precision_flop_limit_predict_s() * 1e3
     );
     println!(
-        "streaming step (30 particles, {} precision): {:.1} us, {:.1} GFLOP/s",
-        r.precision,
+        "streaming step (30 particles, in {}): {:.1} us, {:.1} GFLOP/s",
+        r.prediction_float(),
         r.stream_step_s * 1e6,
         r.stream_gflops
     );
