@@ -3,12 +3,14 @@
 //! code (prssm-notes §3) and this machine's own f64 GEMM rate.
 
 use flapssm_prssm::Precision;
-use flapssm_prssm::train::bench::{
+use flapssm_prssm::bench::{
     REFERENCE_SOLVE_S, gemm_rate_gflops, initial_model, predict_step_flops,
     reference_solve_seconds, synthetic_objective, time_batches, time_prediction, time_stream_step,
     train_step_f32_flops, train_step_flops,
 };
-use flapssm_prssm::train::fit::{DEFAULT_WINDOWS_PER_TASK, FitError, FitSpec, Preset};
+use flapssm_prssm::train::fit::{DEFAULT_WINDOWS_PER_TASK, FitError, FitSpec};
+
+use crate::presets::Preset;
 
 use crate::error::{JobError, Result};
 use crate::threads::current_threads;
@@ -168,7 +170,7 @@ pub fn bench(settings: &BenchSettings) -> Result<BenchReport> {
     }
     let spec = FitSpec {
         windows_per_task: settings.windows_per_task,
-        ..FitSpec::preset(Preset::Paper, 7, 5)
+        ..Preset::Paper.fit_spec(7, 5)
     };
     let gemm_gflops = gemm_rate_gflops::<f64>(512, 0.3);
     let gemm_f32_gflops = gemm_rate_gflops::<f32>(512, 0.3);

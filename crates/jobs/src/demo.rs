@@ -856,7 +856,7 @@ mod tests {
     #[test]
     fn full_with_the_fast_preset_keeps_the_published_protocol() {
         let mut fast = DemoConfig::full(3);
-        fast.training.preset = flapssm_prssm::train::Preset::PaperFast;
+        fast.training.preset = crate::presets::Preset::PaperFast;
         let published = DemoConfig::full(3).training.check().unwrap();
         let published = published.spec();
         let plan = fast.training.check().unwrap();

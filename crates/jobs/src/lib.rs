@@ -36,6 +36,7 @@ pub mod files;
 pub mod kinematics_compare;
 pub mod models;
 pub mod predict;
+pub mod presets;
 pub mod progress;
 pub mod resources;
 pub mod rig;

@@ -591,10 +591,10 @@ impl SweepTable {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::presets::Preset;
     use crate::progress::NoProgress;
     use crate::progress::StopAfter;
     use crate::test_data::tiny_dataset;
-    use flapssm_prssm::train::fit::Preset;
 
     fn tiny_settings(dx: usize) -> SweepSettings {
         SweepSettings {

@@ -4,7 +4,9 @@
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 
-use flapssm_prssm::train::fit::{FitError, FitOutcome, FitSpec, ObjectiveForm, Preset, fit};
+use flapssm_prssm::train::fit::{FitError, FitOutcome, FitSpec, ObjectiveForm, fit};
+
+pub use crate::presets::Preset;
 use flapssm_prssm::train::{
     BestBy, Budget, Checkpoint, InducingInit, LrSchedule, TrainEvent, TrainHooks,
 };
@@ -105,7 +107,7 @@ impl Default for TrainingOptions {
 impl TrainingOptions {
     /// The fit specification for 7 inputs and 5 outputs (unchecked; [`Self::check`] checks it).
     pub fn spec(&self) -> FitSpec {
-        let mut spec = FitSpec::preset(self.preset, 7, 5);
+        let mut spec = self.preset.fit_spec(7, 5);
         if let Some(v) = self.dx {
             spec.model.n_state = v;
         }
@@ -655,7 +657,7 @@ mod tests {
         // No override: the paper preset.
         let p = TrainingOptions::default().spec();
         assert_eq!(p, {
-            let mut f = FitSpec::preset(Preset::Paper, 7, 5);
+            let mut f = Preset::Paper.fit_spec(7, 5);
             f.train.checkpoint_every = 10;
             f
         });

@@ -16,8 +16,8 @@ use std::hint::black_box;
 use std::time::Instant;
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
+use flapssm_prssm::bench::{gemm_rate_gflops, predict_step_flops, train_step_flops};
 use flapssm_prssm::predict::predict;
-use flapssm_prssm::train::bench::{gemm_rate_gflops, predict_step_flops, train_step_flops};
 use flapssm_prssm::{
     Elbo, ElboOptions, ModelConfig, Objective, ParamInit, Params, Sequence, TrainingData, Window,
 };

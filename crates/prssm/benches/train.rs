@@ -4,18 +4,17 @@
 //! step over the paper's parameter vector.
 
 use criterion::{BenchmarkId, Criterion, black_box, criterion_group, criterion_main};
+use flapssm_prssm::ModelConfig;
 use flapssm_prssm::Objective;
+use flapssm_prssm::bench::{initial_model, synthetic_objective, time_batches, time_prediction};
 use flapssm_prssm::stream::StreamPredictor;
 use flapssm_prssm::train::Adam;
-use flapssm_prssm::train::bench::{
-    initial_model, synthetic_objective, time_batches, time_prediction,
-};
-use flapssm_prssm::train::fit::{FitSpec, Preset};
+use flapssm_prssm::train::fit::FitSpec;
 
 fn benches(c: &mut Criterion) {
     let mut g = c.benchmark_group("train");
     g.sample_size(10);
-    let spec = FitSpec::preset(Preset::Paper, 7, 5);
+    let spec = FitSpec::new(ModelConfig::new(12, 5, 7, 100));
     let (elbo, params) = synthetic_objective(&spec, 16, 470, 0).unwrap();
     g.bench_with_input(
         BenchmarkId::new("paper_minibatch_16x470x30", 16),

@@ -32,6 +32,8 @@
 //!   over [`predict::predict_standardized`]; [`Normalization::of_sequences`] for the statistics).
 #![warn(missing_docs)]
 
+#[cfg(feature = "bench")]
+pub mod bench;
 pub mod conditional;
 pub mod elbo;
 pub mod io;

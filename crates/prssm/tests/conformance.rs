@@ -100,7 +100,7 @@ fn particles_and_moments_match_published_run() {
 /// standard form's likelihood is exactly the published one ÷ 30 particles.
 #[test]
 fn published_code_objective_matches_the_authors_loss() {
-    use flapssm_prssm::train::fit::{FitSpec, ObjectiveForm, Preset};
+    use flapssm_prssm::train::fit::{FitSpec, ObjectiveForm};
     use flapssm_prssm::{
         Elbo, ElboOptions, InitialStateGrads, InitialStateMode, InitialStates, LossScaling,
         Objective, Sequence, TrainingData, Window,
@@ -118,7 +118,8 @@ fn published_code_objective_matches_the_authors_loss() {
     let kl_ref = r.scalar("kl_reg").unwrap();
 
     // The fit spec of the mode samples as the published model does.
-    let spec = FitSpec::preset(Preset::Paper, 7, 5).with_objective(ObjectiveForm::PublishedCode);
+    let paper = FitSpec::new(flapssm_prssm::ModelConfig::new(12, 5, 7, 100));
+    let spec = paper.with_objective(ObjectiveForm::PublishedCode);
     assert_eq!(spec.model, m.config, "published-code model config");
     assert!(spec.check_objective().is_ok());
     let standard = spec.clone().with_objective(ObjectiveForm::Standard);

@@ -11,10 +11,10 @@
 use std::path::{Path, PathBuf};
 
 use flapssm_data::npz::NpzReader;
+use flapssm_prssm::bench::synthetic_sequences;
 use flapssm_prssm::conditional::{ConditionalWorkspace, Posterior};
 use flapssm_prssm::published::import_published;
-use flapssm_prssm::train::bench::synthetic_sequences;
-use flapssm_prssm::train::fit::{FitSpec, Preset};
+use flapssm_prssm::train::fit::FitSpec;
 use flapssm_prssm::{
     CovarianceStructure, Elbo, ElboOptions, KernelKind, ModelConfig, Objective, ParamInit,
     Parametrization, Params, Precision, TrainingData, Window,
@@ -96,7 +96,7 @@ fn paper_elbo(config: &ModelConfig, n: usize, len: usize) -> Elbo {
 
 #[test]
 fn paper_configuration_at_its_start() {
-    let spec = FitSpec::preset(Preset::Paper, 7, 5);
+    let spec = FitSpec::new(ModelConfig::new(12, 5, 7, 100));
     let elbo = paper_elbo(&spec.model, 8, 120);
     let theta = Params::init(&spec.model, &spec.init, 5).unconstrained(&spec.model);
     assert_close("paper start", &elbo, &theta, &whole(8, 120), (1e-9, 1e-6));
@@ -170,7 +170,7 @@ fn small_models() {
 /// each product sequential).
 #[test]
 fn mixed_results_do_not_depend_on_the_thread_count() {
-    let spec = FitSpec::preset(Preset::Paper, 7, 5);
+    let spec = FitSpec::new(ModelConfig::new(12, 5, 7, 100));
     let elbo = paper_elbo(&spec.model, 8, 60);
     let theta = Params::init(&spec.model, &spec.init, 5).unconstrained(&spec.model);
     let on = |threads: usize| {

@@ -7,10 +7,10 @@ mod common;
 use flapssm_prssm::Elbo;
 mod systems;
 
-use flapssm_prssm::train::fit::{FitSpec, Preset, fit};
+use flapssm_prssm::train::fit::{FitSpec, fit};
 use flapssm_prssm::train::{
-    Budget, InitialStateSpec, LrSchedule, RecognitionConfig, RecognizedElbo, TrainEvent,
-    TrainHooks, WindowSpec,
+    Budget, InitialStateSpec, LrSchedule, RecognitionConfig, RecognizedElbo, TrainConfig,
+    TrainEvent, TrainHooks, WindowSpec,
 };
 use flapssm_prssm::{
     ElboOptions, InitialStateMode, KernelKind, LossScaling, ModelConfig, Objective, ParamInit,
@@ -27,6 +27,31 @@ fn sequences(data: &systems::SimulatedData) -> Vec<Sequence> {
             outputs: y.clone(),
         })
         .collect()
+}
+
+/// Doerr et al.'s configuration for one input and one output (the application's `sysid`
+/// preset): `D_x` 4, `M` 20, squared exponential, 50 particles, recognition model, windows of
+/// 50 steps in minibatches of 10, Adam at 0.1 for 3000 iterations.
+fn doerr_spec() -> FitSpec {
+    let mut model = ModelConfig::new(4, 1, 1, 20);
+    model.kernel = KernelKind::SquaredExponential;
+    let mut spec = FitSpec::new(model);
+    spec.init = ParamInit {
+        process_noise_var: 0.002 * 0.002,
+        obs_noise_var: 1.0,
+        ..ParamInit::default()
+    };
+    (spec.particles, spec.eval_particles, spec.burn_in_fraction) = (50, 50, 0.0);
+    spec.initial_state = InitialStateSpec::Recognition(RecognitionConfig::default());
+    spec.train = TrainConfig {
+        budget: Budget::Iterations(3000),
+        windows: WindowSpec::Windows { len: 50, stride: 1 },
+        batch_size: 10,
+        lr: 0.1,
+        schedule: LrSchedule::Constant,
+        ..TrainConfig::default()
+    };
+    spec
 }
 
 #[test]
@@ -115,7 +140,7 @@ fn learns_a_forced_duffing_oscillator_with_calibrated_intervals() {
     let test_data = duffing_dataset(&sys, 3, 300, noise, 20);
     let (train, test) = (sequences(&train_data), sequences(&test_data));
 
-    let mut spec = FitSpec::preset(Preset::Sysid, 1, 1);
+    let mut spec = doerr_spec();
     spec.model.n_state = 3;
     spec.particles = 20;
     spec.initial_state = InitialStateSpec::Recognition(RecognitionConfig {
@@ -195,7 +220,7 @@ fn fit_with_validation_is_independent_of_the_thread_count() {
     let sys = Duffing::default();
     let train = sequences(&duffing_dataset(&sys, 4, 80, 0.1, 30));
     let val = sequences(&duffing_dataset(&sys, 3, 80, 0.1, 31));
-    let mut spec = FitSpec::preset(Preset::Sysid, 1, 1);
+    let mut spec = doerr_spec();
     spec.model.n_state = 2;
     spec.particles = 8;
     spec.eval_particles = 8;

@@ -13,7 +13,7 @@ use flapssm_jobs::curve::{
     time_to_quality,
 };
 use flapssm_prssm::Precision;
-use flapssm_prssm::train::bench::REFERENCE_SOLVE_S;
+use flapssm_prssm::bench::REFERENCE_SOLVE_S;
 use flapssm_prssm::train::fit::DEFAULT_WINDOWS_PER_TASK;
 
 /// Measure training, prediction and streaming speed (release build, this machine).

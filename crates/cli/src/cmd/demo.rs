@@ -1,6 +1,6 @@
 //! `flapssm demo`: simulate, fit the LRQSM, train the PR-SSM, evaluate and report, resumably.
 
-use flapssm_prssm::train::Preset;
+use flapssm_jobs::presets::Preset;
 use std::path::PathBuf;
 
 use anyhow::Context;

@@ -6,11 +6,11 @@ use anyhow::Context;
 use clap::{Args, Subcommand};
 use flapssm_jobs::files::check_outputs;
 use flapssm_jobs::files::save_json;
+use flapssm_jobs::presets::Preset;
 use flapssm_jobs::sweep::{
     SweepKind, SweepSettings, SweepTable, checkpoint_beside, load_result, sweep_run,
 };
 use flapssm_jobs::train::TrainingOptions;
-use flapssm_prssm::train::fit::Preset;
 use flapssm_wing::dataset::Dataset;
 
 use crate::cmd::choices::TrainingChoices;

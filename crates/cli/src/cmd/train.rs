@@ -5,9 +5,9 @@ use std::path::PathBuf;
 use anyhow::{Context, bail};
 use clap::Args;
 use flapssm_jobs::JobError;
+use flapssm_jobs::presets::Preset;
 use flapssm_jobs::train::{TrainFiles, TrainingOptions, train_dataset};
 use flapssm_prssm::train::LrSchedule;
-use flapssm_prssm::train::fit::Preset;
 use flapssm_wing::dataset::Dataset;
 
 use crate::cmd::choices::{BestByArg, ObjectiveArg, TrainingChoices};

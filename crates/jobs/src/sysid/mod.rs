@@ -23,7 +23,9 @@
 
 use flapssm_data::table::TableError;
 use flapssm_prssm::train::Budget;
-use flapssm_prssm::train::fit::{FitError, FitSpec, Preset};
+use flapssm_prssm::train::fit::{FitError, FitSpec};
+
+use crate::presets::Preset;
 use serde::{Deserialize, Serialize};
 
 mod figure;
@@ -139,7 +141,7 @@ impl SysidSpec {
             restarts: 1,
             combine: Combine::Ensemble,
             predict_particles: 50,
-            fit: FitSpec::preset(Preset::Sysid, n_input, n_output),
+            fit: Preset::Sysid.fit_spec(n_input, n_output),
         }
     }
 

@@ -2,22 +2,10 @@
 //! training loop and the resulting [`PrssmModel`]s (best and last). Prediction with the
 //! model's initial-state rule is [`PrssmModel::predict_sequence`].
 //!
-//! Presets ([`Preset`]):
-//!
-//! | setting | `paper` (notes §1) | `paper-fast` | `sysid` (notes §2, Doerr et al.) |
-//! |---|---|---|---|
-//! | `D_x`, `M`, kernel | 12, 100, Matern-3/2 | as `paper` | 4, 20, squared exponential |
-//! | initial lengthscales | 2 | 10 | 2 |
-//! | particles (training / evaluation) | 30 / 30 | 10 / 30 | 50 / 50 |
-//! | minibatches | 16 whole sequences | 4 whole sequences | 10 windows of 50 steps, stride 1 |
-//! | Adam | lr 0.03, 1000 epochs | lr 0.03 cosine-annealed to 0.003, 300 epochs | lr 0.1, 3000 iterations |
-//! | precision, windows per task | f64, 4 | mixed, 2 | f64, 4 |
-//! | initial state | zeros, 20 % burn-in | as `paper` | recognition model, first 16 steps |
-//! | noise init `σ_x²`, `σ_y²` | 2.5e-5, 2.5e-3 | as `paper` | 0.002², 1.0 |
-//!
-//! `paper-fast` is the paper's model trained for time to quality (docs/training.md, "Time to
-//! quality"): a start of the lengthscales near where training takes them, more, cheaper
-//! steps, and a learning rate that anneals so that the last epochs settle.
+//! [`FitSpec::new`] starts from the settings of Bayiz & Cheng's published run (whole
+//! sequences in minibatches of 16, 30 particles, Adam at 0.03 for 1000 epochs, zero initial
+//! state with 20 % burn-in); the application's named presets (`flapssm_jobs::presets`) are
+//! built on it.
 //!
 //! Inputs and outputs are standardized with the training mean and standard deviation
 //! (ddof 0; a constant channel gets std 1), stored in the model. Reported RMSEs
@@ -32,7 +20,7 @@ use super::batches::{BatchPlan, WindowSpec, derive_seed};
 use super::checkpoint::Checkpoint;
 use super::inducing::{InducingInit, kmeans_start};
 use super::initial::{InitialStateModel, InitialStateSpec, RecognizedElbo};
-use super::recognition::{Recognition, RecognitionConfig};
+use super::recognition::Recognition;
 use super::schedule::LrSchedule;
 use super::trainer::{
     Budget, Evaluation, TrainConfig, TrainError, TrainHooks, TrainOutcome, train,
@@ -41,39 +29,11 @@ use crate::elbo::{
     Elbo, ElboError, ElboOptions, InitialStateMode, LossScaling, Sequence, SequenceView,
     TrainingData, sequence_lengths,
 };
-use crate::kernel::KernelKind;
 use crate::model::{Normalization, PrssmModel};
 use crate::params::{ConfigError, ModelConfig, ParamInit, Params};
 use crate::precision::Precision;
 use crate::predict::{self, Prediction};
 use crate::{Objective, ObjectiveError};
-
-/// Named training presets (see the module docs).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Preset {
-    /// Bayiz & Cheng 2021, the published flapping-wing run.
-    Paper,
-    /// The paper's model trained for time to quality (see the module docs).
-    #[serde(rename = "paper-fast")]
-    PaperFast,
-    /// Doerr et al. 2018 on the system-identification benchmarks.
-    Sysid,
-}
-
-impl std::str::FromStr for Preset {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        match s {
-            "paper" => Ok(Preset::Paper),
-            "paper-fast" => Ok(Preset::PaperFast),
-            "sysid" => Ok(Preset::Sysid),
-            _ => Err(format!(
-                "unknown preset {s:?} (expected paper, paper-fast or sysid)"
-            )),
-        }
-    }
-}
 
 /// Which training objective a fit minimizes.
 ///
@@ -153,78 +113,32 @@ fn default_windows_per_task() -> usize {
 }
 
 impl FitSpec {
-    /// The preset for `n_input` inputs and `n_output` outputs.
-    pub fn preset(preset: Preset, n_input: usize, n_output: usize) -> Self {
-        match preset {
-            Preset::Paper => Self {
-                model: ModelConfig::new(12.max(n_output), n_output, n_input, 100),
-                init: ParamInit::default(),
-                particles: 30,
-                burn_in_fraction: 0.2,
-                initial_state: InitialStateSpec::Zeros,
-                train: TrainConfig {
-                    budget: Budget::Epochs(1000),
-                    windows: WindowSpec::WholeSequences,
-                    batch_size: 16,
-                    lr: 0.03,
-                    schedule: LrSchedule::Constant,
-                    ..TrainConfig::default()
-                },
-                eval_particles: 30,
-                eval_max_sequences: 16,
-                objective: ObjectiveForm::Standard,
-                inducing_init: InducingInit::Uniform,
-                precision: Precision::F64,
-                windows_per_task: DEFAULT_WINDOWS_PER_TASK,
+    /// A fit of `model` with the settings of the published run: initial parameters
+    /// [`ParamInit::default`], 30 particles (training and evaluation), 20 % burn-in, zero
+    /// initial state, whole sequences in minibatches of 16, Adam at a constant 0.03 for 1000
+    /// epochs, 16 training sequences evaluated per epoch, the standard objective, uniform
+    /// inducing inputs, `f64`, [`DEFAULT_WINDOWS_PER_TASK`] windows per task.
+    pub fn new(model: ModelConfig) -> Self {
+        Self {
+            model,
+            init: ParamInit::default(),
+            particles: 30,
+            burn_in_fraction: 0.2,
+            initial_state: InitialStateSpec::Zeros,
+            train: TrainConfig {
+                budget: Budget::Epochs(1000),
+                windows: WindowSpec::WholeSequences,
+                batch_size: 16,
+                lr: 0.03,
+                schedule: LrSchedule::Constant,
+                ..TrainConfig::default()
             },
-            Preset::PaperFast => {
-                let paper = Self::preset(Preset::Paper, n_input, n_output);
-                Self {
-                    init: ParamInit {
-                        lengthscale: 10.0,
-                        ..paper.init
-                    },
-                    particles: 10,
-                    train: TrainConfig {
-                        budget: Budget::Epochs(300),
-                        batch_size: 4,
-                        schedule: LrSchedule::Cosine { final_factor: 0.1 },
-                        ..paper.train
-                    },
-                    precision: Precision::Mixed,
-                    windows_per_task: 2,
-                    ..paper
-                }
-            }
-            Preset::Sysid => {
-                let mut model = ModelConfig::new(4.max(n_output), n_output, n_input, 20);
-                model.kernel = KernelKind::SquaredExponential;
-                Self {
-                    model,
-                    init: ParamInit {
-                        process_noise_var: 0.002 * 0.002,
-                        obs_noise_var: 1.0,
-                        ..ParamInit::default()
-                    },
-                    particles: 50,
-                    burn_in_fraction: 0.0,
-                    initial_state: InitialStateSpec::Recognition(RecognitionConfig::default()),
-                    train: TrainConfig {
-                        budget: Budget::Iterations(3000),
-                        windows: WindowSpec::Windows { len: 50, stride: 1 },
-                        batch_size: 10,
-                        lr: 0.1,
-                        schedule: LrSchedule::Constant,
-                        ..TrainConfig::default()
-                    },
-                    eval_particles: 50,
-                    eval_max_sequences: 16,
-                    objective: ObjectiveForm::Standard,
-                    inducing_init: InducingInit::Uniform,
-                    precision: Precision::F64,
-                    windows_per_task: DEFAULT_WINDOWS_PER_TASK,
-                }
-            }
+            eval_particles: 30,
+            eval_max_sequences: 16,
+            objective: ObjectiveForm::Standard,
+            inducing_init: InducingInit::Uniform,
+            precision: Precision::F64,
+            windows_per_task: DEFAULT_WINDOWS_PER_TASK,
         }
     }
 
@@ -510,55 +424,4 @@ fn data_fingerprint(sequences: &[SequenceView<'_>]) -> serde_json::Value {
         "values": n_values,
         "fnv1a64": format!("{hash:016x}"),
     })
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// `paper-fast` is the paper's model (same structure, kernel, noise and initial state)
-    /// with the fast training of docs/training.md; its names parse and serialize as the
-    /// command line spells them.
-    #[test]
-    fn paper_fast_is_the_paper_model_with_fast_training() {
-        let (paper, fast) = (
-            FitSpec::preset(Preset::Paper, 7, 5),
-            FitSpec::preset(Preset::PaperFast, 7, 5),
-        );
-        assert_eq!(fast.model, paper.model);
-        assert_eq!(fast.initial_state, paper.initial_state);
-        assert_eq!(fast.burn_in_fraction, paper.burn_in_fraction);
-        assert_eq!(
-            ParamInit {
-                lengthscale: 2.0,
-                ..fast.init
-            },
-            paper.init
-        );
-        assert_eq!(fast.init.lengthscale, 10.0);
-        assert_eq!((fast.particles, fast.eval_particles), (10, 30));
-        assert_eq!((fast.train.batch_size, fast.train.lr), (4, 0.03));
-        assert_eq!(fast.train.budget, Budget::Epochs(300));
-        assert_eq!(
-            fast.train.schedule,
-            LrSchedule::Cosine { final_factor: 0.1 }
-        );
-        assert_eq!(
-            (fast.precision, fast.windows_per_task),
-            (Precision::Mixed, 2)
-        );
-        assert_eq!(
-            (paper.precision, paper.windows_per_task),
-            (Precision::F64, DEFAULT_WINDOWS_PER_TASK)
-        );
-        for (name, preset) in [
-            ("paper", Preset::Paper),
-            ("paper-fast", Preset::PaperFast),
-            ("sysid", Preset::Sysid),
-        ] {
-            assert_eq!(name.parse::<Preset>(), Ok(preset));
-            assert_eq!(serde_json::to_value(preset).unwrap(), name);
-        }
-        assert!("fast".parse::<Preset>().unwrap_err().contains("paper-fast"));
-    }
 }

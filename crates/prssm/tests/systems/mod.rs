@@ -10,7 +10,7 @@
 //! (dimensionless time and position). The input is held constant over each sample period
 //! (zero-order hold) and the state integrated with classical RK4 sub-steps.
 
-use flapssm_prssm::train::bench::random_input;
+use flapssm_prssm::bench::random_input;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rand_distr::StandardNormal;

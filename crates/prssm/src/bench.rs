@@ -13,14 +13,14 @@ use faer::linalg::triangular_solve::solve_lower_triangular_in_place;
 use faer::traits::ComplexField;
 use faer::{Accum, Mat, Par};
 
-use super::batches::{BatchPlan, WindowSpec, derive_seed};
-use super::fit::FitSpec;
 use crate::elbo::{Elbo, ElboError, ElboOptions, Sequence, TrainingData};
 use crate::model::PrssmModel;
 use crate::params::{ModelConfig, Params};
 use crate::predict;
 use crate::step::StepFloat;
 use crate::stream::StreamPredictor;
+use crate::train::batches::{BatchPlan, WindowSpec, derive_seed};
+use crate::train::fit::FitSpec;
 use crate::{Objective, ObjectiveError, Window};
 
 /// Smooth random excitation: Gaussian levels of standard deviation `amplitude`, held for
@@ -334,13 +334,12 @@ pub fn time_stream_step<T: StepFloat>(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::train::fit::Preset;
 
     /// The FLOP model against a hand count for the paper's shapes (M 100, D 19, D_x 12):
     /// `6·100²·480 + 6·100·19·480 + 12·100·12·480` and `2·112·100·30 + 2·12·100·30 + 2·100·12·30`.
     #[test]
     fn flop_model_of_the_paper_configuration() {
-        let spec = FitSpec::preset(Preset::Paper, 7, 5);
+        let spec = FitSpec::new(ModelConfig::new(12, 5, 7, 100));
         let train = train_step_flops(&spec.model, 480);
         assert_eq!(train, 28_800_000.0 + 5_472_000.0 + 6_912_000.0);
         let predict = predict_step_flops(&spec.model, 30);
@@ -382,7 +381,7 @@ mod tests {
     /// FLOP count is that of the transitions computed (2 × 16 windows × 9 steps).
     #[test]
     fn batch_times_are_consistent() {
-        let spec = FitSpec::preset(Preset::Paper, 7, 5);
+        let spec = FitSpec::new(ModelConfig::new(12, 5, 7, 100));
         let (elbo, params) = synthetic_objective(&spec, 32, 10, 1).unwrap();
         let t = time_batches(&elbo, &params, 2, 1).unwrap();
         assert!(t.fastest_s > 0.0 && 2.0 * t.fastest_s <= t.total_s, "{t:?}");
