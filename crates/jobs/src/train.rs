@@ -105,6 +105,86 @@ impl Default for TrainingOptions {
 }
 
 impl TrainingOptions {
+    /// Every option by name, as the Python keywords and (with `-` for `_`) the command line's
+    /// flags spell it: the one schema both front ends map onto.
+    pub const NAMES: [&'static str; 20] = [
+        "preset",
+        "dx",
+        "inducing",
+        "particles",
+        "epochs",
+        "iterations",
+        "batch",
+        "lr",
+        "schedule",
+        "eval_every",
+        "seed",
+        "val_fraction",
+        "best_by",
+        "objective",
+        "inducing_init",
+        "patience",
+        "precision",
+        "windows_per_task",
+        "lengthscale_init",
+        "checkpoint_every",
+    ];
+
+    /// Sets the option `name` ([`Self::NAMES`]) from `value` spelled as on the command line
+    /// (`paper-fast`, `cosine:0.1`, `training-loss`, `mixed`, numbers). Ranges are
+    /// [`Self::check`]'s.
+    ///
+    /// # Errors
+    /// [`JobError::Setting`] for an unknown name or a value that does not parse.
+    pub fn set(&mut self, name: &str, value: &str) -> Result<()> {
+        fn parse<T: std::str::FromStr>(name: &str, value: &str, what: &str) -> Result<T> {
+            value.parse().map_err(|_| JobError::Setting {
+                name: name.into(),
+                value: value.into(),
+                expected: format!("must be {what}"),
+            })
+        }
+        fn named<T: std::str::FromStr<Err = String>>(name: &str, value: &str) -> Result<T> {
+            value.parse().map_err(|e: String| JobError::Setting {
+                name: name.into(),
+                value: value.into(),
+                expected: e,
+            })
+        }
+        let whole = "a whole number";
+        let real = "a number";
+        match name {
+            "preset" => self.preset = named(name, value)?,
+            "dx" => self.dx = Some(parse(name, value, whole)?),
+            "inducing" => self.inducing = Some(parse(name, value, whole)?),
+            "particles" => self.particles = Some(parse(name, value, whole)?),
+            "epochs" => self.epochs = Some(parse(name, value, whole)?),
+            "iterations" => self.iterations = Some(parse(name, value, whole)?),
+            "batch" => self.batch = Some(parse(name, value, whole)?),
+            "lr" => self.lr = Some(parse(name, value, real)?),
+            "schedule" => self.schedule = Some(named(name, value)?),
+            "eval_every" => self.eval_every = Some(parse(name, value, whole)?),
+            "seed" => self.seed = parse(name, value, whole)?,
+            "val_fraction" => self.val_fraction = parse(name, value, real)?,
+            "best_by" => self.best_by = named(name, value)?,
+            "objective" => self.objective = named(name, value)?,
+            "inducing_init" => self.inducing_init = Some(named(name, value)?),
+            "patience" => self.patience = Some(parse(name, value, whole)?),
+            "precision" => self.precision = Some(named(name, value)?),
+            "windows_per_task" => self.windows_per_task = Some(parse(name, value, whole)?),
+            "lengthscale_init" => self.lengthscale_init = Some(parse(name, value, real)?),
+            "checkpoint_every" => self.checkpoint_every = parse(name, value, whole)?,
+            _ => {
+                return Err(JobError::Setting {
+                    name: name.into(),
+                    value: value.into(),
+                    expected: format!("an option of training: one of {}", Self::NAMES.join(", ")),
+                });
+            }
+        }
+        Ok(())
+    }
+
     /// The fit specification for 7 inputs and 5 outputs (unchecked; [`Self::check`] checks it).
     pub fn spec(&self) -> FitSpec {
         let mut spec = self.preset.fit_spec(7, 5);
@@ -582,6 +662,68 @@ pub fn train_in_memory(
 mod tests {
     use super::*;
     use crate::test_data::tiny_dataset;
+
+    /// [`TrainingOptions::NAMES`] are exactly the fields (so a new field fails here until the
+    /// schema, the command line and Python have it), and each name sets its field from the
+    /// command line's spelling.
+    #[test]
+    fn the_option_names_are_the_fields_and_each_sets_its_own() {
+        let fields = serde_json::to_value(TrainingOptions::default()).unwrap();
+        let mut fields: Vec<&str> = fields
+            .as_object()
+            .unwrap()
+            .keys()
+            .map(String::as_str)
+            .collect();
+        let mut names = TrainingOptions::NAMES.to_vec();
+        fields.sort_unstable();
+        names.sort_unstable();
+        assert_eq!(fields, names);
+        let values = [
+            ("preset", "paper-fast"),
+            ("dx", "6"),
+            ("inducing", "30"),
+            ("particles", "7"),
+            ("epochs", "12"),
+            ("iterations", "40"),
+            ("batch", "3"),
+            ("lr", "0.01"),
+            ("schedule", "cosine:0.1"),
+            ("eval_every", "2"),
+            ("seed", "9"),
+            ("val_fraction", "0.2"),
+            ("best_by", "training-loss"),
+            ("objective", "published-code"),
+            ("inducing_init", "kmeans"),
+            ("patience", "5"),
+            ("precision", "mixed"),
+            ("windows_per_task", "2"),
+            ("lengthscale_init", "3.5"),
+            ("checkpoint_every", "0"),
+        ];
+        assert_eq!(values.len(), TrainingOptions::NAMES.len());
+        let default = serde_json::to_value(TrainingOptions::default()).unwrap();
+        for (name, value) in values {
+            let mut o = TrainingOptions::default();
+            o.set(name, value).unwrap();
+            let changed = serde_json::to_value(&o).unwrap();
+            for key in TrainingOptions::NAMES {
+                let moved = changed[key] != default[key];
+                assert_eq!(moved, key == name, "setting {name} = {value} moved {key}");
+            }
+        }
+        let e = TrainingOptions::default().set("epoch", "3").unwrap_err();
+        assert!(
+            e.to_string().contains("epoch") && e.to_string().contains("epochs"),
+            "{e}"
+        );
+        let e = TrainingOptions::default().set("dx", "1.5").unwrap_err();
+        assert!(e.to_string().contains("whole number"), "{e}");
+        let e = TrainingOptions::default()
+            .set("schedule", "linear")
+            .unwrap_err();
+        assert!(e.to_string().contains("unknown schedule"), "{e}");
+    }
 
     #[test]
     fn validation_split_follows_the_fraction() {

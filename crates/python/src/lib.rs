@@ -26,6 +26,10 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(dataset::kinematics, m)?)?;
     m.add_function(wrap_pyfunction!(sysid::sysid, m)?)?;
     m.add_function(wrap_pyfunction!(prssm::train, m)?)?;
+    m.add(
+        "TRAINING_OPTIONS",
+        flapssm_jobs::train::TrainingOptions::NAMES.to_vec(),
+    )?;
     m.add_function(wrap_pyfunction!(evaluate::evaluate, m)?)?;
     m.add_function(wrap_pyfunction!(rig::rig_check, m)?)?;
     m.add("INPUT_NAMES", flapssm_wing::dataset::INPUT_NAMES.to_vec())?;

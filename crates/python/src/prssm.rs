@@ -231,78 +231,25 @@ impl Stream {
 /// Returns the best model. Ctrl-C (or an exception of `progress`) stops at the next step
 /// with a checkpoint; `resume=True` continues from it. With `out=None` nothing is written:
 /// the best model is returned from memory (no checkpoint, so no `resume`).
+///
+/// `options` are `(name, value)` pairs of `TrainingOptions::NAMES` (the one schema of the
+/// command line and Python), each value spelled as on the command line; the Python wrapper
+/// `flapssm.train` makes them from its keywords.
 #[pyfunction]
-#[pyo3(signature = (dataset, out, preset="paper", dx=None, inducing=None, particles=None,
-    epochs=None, iterations=None, batch=None, lr=None, seed=0, val_fraction=0.1,
-    checkpoint_every=10, resume=false, progress=None, best_by="rmse",
-    objective="standard", inducing_init=None, patience=None, precision=None,
-    windows_per_task=None, lengthscale_init=None))]
-#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (dataset, out, options, resume=false, progress=None))]
 pub fn train(
     py: Python<'_>,
     dataset: &Dataset,
     out: Option<PathBuf>,
-    preset: &str,
-    dx: Option<usize>,
-    inducing: Option<usize>,
-    particles: Option<usize>,
-    epochs: Option<u64>,
-    iterations: Option<u64>,
-    batch: Option<usize>,
-    lr: Option<f64>,
-    seed: u64,
-    val_fraction: f64,
-    checkpoint_every: u64,
+    options: Vec<(String, String)>,
     resume: bool,
     progress: Option<Py<PyAny>>,
-    best_by: &str,
-    objective: &str,
-    inducing_init: Option<&str>,
-    patience: Option<u64>,
-    precision: Option<&str>,
-    windows_per_task: Option<usize>,
-    lengthscale_init: Option<f64>,
 ) -> PyResult<Prssm> {
-    let best_by: flapssm_prssm::train::BestBy = best_by
-        .parse()
-        .map_err(|e: String| PyValueError::new_err(format!("best_by: {e}")))?;
-    let objective: flapssm_prssm::train::fit::ObjectiveForm = objective
-        .parse()
-        .map_err(|e: String| PyValueError::new_err(format!("objective: {e}")))?;
-    let inducing_init: Option<flapssm_prssm::train::InducingInit> = inducing_init
-        .map(str::parse)
-        .transpose()
-        .map_err(|e: String| PyValueError::new_err(format!("inducing_init: {e}")))?;
-    let precision: Option<flapssm_prssm::Precision> = precision
-        .map(str::parse)
-        .transpose()
-        .map_err(|e: String| PyValueError::new_err(format!("precision: {e}")))?;
-    let plan = TrainingOptions {
-        preset: preset
-            .parse()
-            .map_err(|e: String| PyValueError::new_err(format!("preset: {e}")))?,
-        dx,
-        inducing,
-        particles,
-        epochs,
-        iterations,
-        batch,
-        lr,
-        schedule: None,
-        eval_every: None,
-        seed,
-        val_fraction,
-        best_by,
-        objective,
-        inducing_init,
-        patience,
-        precision,
-        windows_per_task,
-        lengthscale_init,
-        checkpoint_every,
+    let mut plan = TrainingOptions::default();
+    for (name, value) in &options {
+        plan.set(name, value).map_err(|e| job_error(e, None))?;
     }
-    .check()
-    .map_err(|e| job_error(e, None))?;
+    let plan = plan.check().map_err(|e| job_error(e, None))?;
     let Some(out) = out else {
         if resume {
             return Err(PyValueError::new_err(

@@ -106,6 +106,10 @@ def test_bad_input_raises_the_right_exception(small, tmp_path):
         flapssm.train(small, tmp_path / "m.json", lengthscale_init=-1.0)
     with pytest.raises(ValueError, match="windows_per_task"):
         flapssm.train(small, tmp_path / "m.json", windows_per_task=0)
+    with pytest.raises(ValueError, match="unknown schedule"):
+        flapssm.train(small, tmp_path / "m.json", schedule="linear")
+    with pytest.raises(ValueError, match="dx"):
+        flapssm.train(small, tmp_path / "m.json", dx=2.5)
     with pytest.raises(OSError, match="is a directory"):
         small.save(tmp_path)
 
@@ -191,6 +195,16 @@ def test_estimators_follow_scikit_learn_conventions(small):
                                    predict_particles=5)
     mean, std = prssm.fit(small).predict(small, return_std=True)
     assert mean.shape == (4, 470, 5) and (std > 0).all() and prssm.n_state_ == 5
+
+
+def test_train_keywords_are_the_training_options():
+    """One schema: the training keywords of ``flapssm.train`` are ``TRAINING_OPTIONS`` (the
+    ``flapssm train`` flags), besides the dataset, the files and the callback."""
+    import inspect
+
+    keywords = set(inspect.signature(flapssm.train).parameters)
+    assert keywords - {"dataset", "out", "resume", "progress"} == set(flapssm.TRAINING_OPTIONS)
+    assert "schedule" in flapssm.TRAINING_OPTIONS and "eval_every" in flapssm.TRAINING_OPTIONS
 
 
 def test_train_in_memory_writes_nothing(small, tmp_path, monkeypatch):

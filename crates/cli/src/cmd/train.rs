@@ -1,8 +1,9 @@
-//! `flapssm train DATASET --out MODEL`: fit a PR-SSM to a flapssm dataset.
+//! `flapssm train DATASET --out MODEL`: fit a PR-SSM to a flapssm dataset. Its training
+//! flags are `TrainingOptions::NAMES` (tested below).
 
 use std::path::PathBuf;
 
-use anyhow::{Context, bail};
+use anyhow::Context;
 use clap::Args;
 use flapssm_jobs::JobError;
 use flapssm_jobs::presets::Preset;
@@ -49,9 +50,12 @@ pub struct TrainArgs {
     #[arg(long)]
     lr: Option<f64>,
     /// Learning-rate schedule: constant, step:EVERY:FACTOR, exp:FINAL_FACTOR,
-    /// cosine:FINAL_FACTOR.
+    /// cosine:FINAL_FACTOR (the preset's when absent).
     #[arg(long)]
-    schedule: Option<String>,
+    schedule: Option<LrSchedule>,
+    /// Evaluate (best-model tracking) every N epochs (the preset's when absent).
+    #[arg(long, value_parser = super::positive::<u64>)]
+    eval_every: Option<u64>,
     /// Seed of initialization, shuffles and particle draws.
     #[arg(long, default_value_t = 0)]
     seed: u64,
@@ -79,34 +83,8 @@ pub struct TrainArgs {
     resume: bool,
 }
 
-fn parse_schedule(s: &str) -> anyhow::Result<LrSchedule> {
-    let parts: Vec<&str> = s.split(':').collect();
-    let num = |i: usize| -> anyhow::Result<f64> {
-        parts
-            .get(i)
-            .with_context(|| format!("--schedule {s}: missing field {i}"))?
-            .parse::<f64>()
-            .with_context(|| format!("--schedule {s}: field {i} is not a number"))
-    };
-    Ok(match parts[0] {
-        "constant" => LrSchedule::Constant,
-        "step" => LrSchedule::Step {
-            every: num(1)? as u64,
-            factor: num(2)?,
-        },
-        "exp" => LrSchedule::Exponential {
-            final_factor: num(1)?,
-        },
-        "cosine" => LrSchedule::Cosine {
-            final_factor: num(1)?,
-        },
-        other => bail!("--schedule: unknown kind {other:?} (constant, step, exp, cosine)"),
-    })
-}
-
 /// Runs `flapssm train`.
 pub fn run(args: TrainArgs) -> anyhow::Result<()> {
-    let schedule = args.schedule.as_deref().map(parse_schedule).transpose()?;
     let mut plan = TrainingOptions {
         preset: args.preset,
         dx: args.dx,
@@ -116,8 +94,8 @@ pub fn run(args: TrainArgs) -> anyhow::Result<()> {
         iterations: args.iterations,
         batch: args.batch,
         lr: args.lr,
-        schedule,
-        eval_every: None,
+        schedule: args.schedule,
+        eval_every: args.eval_every,
         seed: args.seed,
         val_fraction: args.val_fraction,
         best_by: args.best_by.into(),
@@ -156,4 +134,29 @@ pub fn run(args: TrainArgs) -> anyhow::Result<()> {
         files.last.display()
     );
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::{Args, Command};
+
+    /// The training flags are exactly the one schema's options ([`TrainingOptions::NAMES`]);
+    /// the rest name files.
+    #[test]
+    fn the_training_flags_are_the_training_options() {
+        let cmd = TrainArgs::augment_args(Command::new("train"));
+        let mut flags: Vec<String> = cmd
+            .get_arguments()
+            .map(|a| a.get_id().to_string())
+            .filter(|id| !["dataset", "out", "checkpoint", "resume"].contains(&id.as_str()))
+            .collect();
+        let mut names: Vec<String> = TrainingOptions::NAMES
+            .iter()
+            .map(|s| s.to_string())
+            .collect();
+        flags.sort_unstable();
+        names.sort_unstable();
+        assert_eq!(flags, names);
+    }
 }

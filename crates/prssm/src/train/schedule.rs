@@ -58,6 +58,61 @@ pub enum ScheduleError {
     },
 }
 
+impl std::str::FromStr for LrSchedule {
+    type Err = String;
+    /// `constant`, `step:EVERY:FACTOR`, `exp:FINAL_FACTOR` or `cosine:FINAL_FACTOR` (the
+    /// command line's and the bindings' spelling); ranges are [`LrSchedule::check`]'s.
+    fn from_str(s: &str) -> Result<Self, String> {
+        let parts: Vec<&str> = s.split(':').collect();
+        let field = |i: usize| -> Result<&str, String> {
+            parts
+                .get(i)
+                .copied()
+                .ok_or_else(|| format!("schedule {s:?}: missing field {i}"))
+        };
+        let num = |i: usize| -> Result<f64, String> {
+            field(i)?
+                .parse::<f64>()
+                .map_err(|_| format!("schedule {s:?}: field {i} is not a number"))
+        };
+        let (schedule, fields) = match parts[0] {
+            "constant" => (LrSchedule::Constant, 1),
+            "step" => {
+                let every = field(1)?
+                    .parse::<u64>()
+                    .map_err(|_| format!("schedule {s:?}: EVERY is not a whole number"))?;
+                let factor = num(2)?;
+                (LrSchedule::Step { every, factor }, 3)
+            }
+            "exp" => (
+                LrSchedule::Exponential {
+                    final_factor: num(1)?,
+                },
+                2,
+            ),
+            "cosine" => (
+                LrSchedule::Cosine {
+                    final_factor: num(1)?,
+                },
+                2,
+            ),
+            other => {
+                return Err(format!(
+                    "unknown schedule {other:?} (expected constant, step:EVERY:FACTOR, \
+                     exp:FINAL_FACTOR or cosine:FINAL_FACTOR)"
+                ));
+            }
+        };
+        if parts.len() != fields {
+            return Err(format!(
+                "schedule {s:?}: {} fields, expected {fields}",
+                parts.len()
+            ));
+        }
+        Ok(schedule)
+    }
+}
+
 impl LrSchedule {
     /// Checks the parameters.
     ///
@@ -118,6 +173,36 @@ impl LrSchedule {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn schedules_parse_as_the_command_line_spells_them() {
+        assert_eq!("constant".parse(), Ok(LrSchedule::Constant));
+        assert_eq!(
+            "step:100:0.5".parse(),
+            Ok(LrSchedule::Step {
+                every: 100,
+                factor: 0.5
+            })
+        );
+        assert_eq!(
+            "exp:0.1".parse(),
+            Ok(LrSchedule::Exponential { final_factor: 0.1 })
+        );
+        assert_eq!(
+            "cosine:0.1".parse(),
+            Ok(LrSchedule::Cosine { final_factor: 0.1 })
+        );
+        for (bad, says) in [
+            ("linear", "unknown schedule"),
+            ("step:10", "missing field 2"),
+            ("step:1.5:0.5", "EVERY"),
+            ("cosine:x", "not a number"),
+            ("cosine:0.1:2", "3 fields, expected 2"),
+        ] {
+            let e = bad.parse::<LrSchedule>().unwrap_err();
+            assert!(e.contains(says), "{bad}: {e}");
+        }
+    }
 
     #[test]
     fn schedules_hit_their_defining_values() {

@@ -22,7 +22,7 @@ from typing import Any, Callable, Optional, Sequence, Union
 import numpy as np
 
 from . import _native
-from ._native import INPUT_NAMES, INPUT_UNITS, OUTPUT_NAMES, OUTPUT_UNITS, Stream
+from ._native import INPUT_NAMES, INPUT_UNITS, OUTPUT_NAMES, OUTPUT_UNITS, TRAINING_OPTIONS, Stream
 from ._arrays import as_float_array
 
 __all__ = [
@@ -30,6 +30,7 @@ __all__ = [
     "INPUT_UNITS",
     "OUTPUT_NAMES",
     "OUTPUT_UNITS",
+    "TRAINING_OPTIONS",
     "Dataset",
     "dataset_from_arrays",
     "LRQSM",
@@ -174,6 +175,8 @@ def train(
     iterations: Optional[int] = None,
     batch: Optional[int] = None,
     lr: Optional[float] = None,
+    schedule: Optional[str] = None,
+    eval_every: Optional[int] = None,
     seed: int = 0,
     val_fraction: float = 0.1,
     checkpoint_every: int = 10,
@@ -192,26 +195,43 @@ def train(
     ``<out>.ckpt.json`` and the learning curve to ``<out>.curve.csv``. Ctrl-C raises
     ``KeyboardInterrupt`` after a checkpoint; ``resume=True`` continues from it (a larger
     budget extends a finished run). With ``out=None`` nothing is written and the best model
-    is returned from memory (an interruption then loses the run). ``best_by``: ``"rmse"`` (validation, else training
+    is returned from memory (an interruption then loses the run).
+
+    The training keywords are ``flapssm train``'s flags with ``_`` for ``-``, one schema
+    (``TRAINING_OPTIONS``), and take the values the command line does; ``None`` keeps the
+    preset's. ``schedule``: ``"constant"``, ``"step:EVERY:FACTOR"``, ``"exp:FINAL"`` or
+    ``"cosine:FINAL"``. ``eval_every``: evaluate (best-model tracking) every that many
+    epochs. ``best_by``: ``"rmse"`` (validation, else training
     rollouts) or ``"training-loss"`` (the published code's ``best.ckpt``; with
     ``val_fraction=0``, the published protocol). ``objective``:
     ``"standard"`` (the unbiased ELBO) or ``"published-code"`` (the authors' objective and
     shared noise draws, to re-run their exact training). ``inducing_init``: ``"uniform"``
-    or ``"kmeans"`` (default: the preset's). ``patience``: end when that many evaluated
+    or ``"kmeans"``. ``patience``: end when that many evaluated
     epochs in a row bring no new best model. ``precision``: ``"f64"`` (the reference) or
-    ``"mixed"`` (the ELBO's large products in f32; default: the preset's). ``windows_per_task``:
-    sequences per parallel task (default: the preset's; a minibatch of ``batch`` keeps at most
+    ``"mixed"`` (the ELBO's large products in f32). ``windows_per_task``:
+    sequences per parallel task (a minibatch of ``batch`` keeps at most
     ``batch / n`` threads busy; results change only in the last bits). ``lengthscale_init``:
-    the initial lengthscale of every GP input in standardized units (default: the preset's).
+    the initial lengthscale of every GP input in standardized units.
     Presets: ``"paper"`` (the published run), ``"paper-fast"`` (the paper's model trained for
     time to quality), ``"sysid"`` (Doerr et al.)."""
+    given = dict(locals())
+    options = [
+        (name, _option_text(given[name]))
+        for name in TRAINING_OPTIONS
+        if given[name] is not None
+    ]
     return _native.train(
-        dataset, None if out is None else os.fspath(out), preset, dx, inducing, particles, epochs, iterations, batch,
-        lr, int(seed), float(val_fraction), int(checkpoint_every), bool(resume), progress,
-        best_by, objective, inducing_init, None if patience is None else int(patience),
-        precision, None if windows_per_task is None else int(windows_per_task),
-        None if lengthscale_init is None else float(lengthscale_init),
+        dataset, None if out is None else os.fspath(out), options, bool(resume), progress
     )
+
+
+def _option_text(value: Any) -> str:
+    """A training option's value as the command line spells it."""
+    if isinstance(value, bool):
+        raise TypeError(f"a training option takes a number or a name, not {value!r}")
+    if isinstance(value, (float, np.floating)):
+        return repr(float(value))
+    return str(value)
 
 
 def evaluate(

@@ -11,6 +11,7 @@ _Progress = Optional[Callable[[str, int, int], Any]]
 _F64 = npt.NDArray[np.float64]
 
 INPUT_NAMES: list[str]
+TRAINING_OPTIONS: list[str]
 OUTPUT_NAMES: list[str]
 INPUT_UNITS: list[str]
 OUTPUT_UNITS: list[str]
@@ -105,15 +106,8 @@ def kinematics(euler_rad: _F64, dt_s: float, half_window: Optional[int] = None,
 def sysid(path: _Path, inputs: list[Union[str, int]], outputs: list[Union[str, int]], split: float = 0.5,
           seeds: int = 3, restarts: int = 2, combine: str = "ensemble", iterations: int = 3000,
           lr: float = 0.1, progress: Optional[Callable[[int, float], Any]] = None) -> str: ...
-def train(dataset: Dataset, out: Optional[_Path], preset: str = "paper", dx: Optional[int] = None,
-          inducing: Optional[int] = None, particles: Optional[int] = None, epochs: Optional[int] = None,
-          iterations: Optional[int] = None, batch: Optional[int] = None, lr: Optional[float] = None,
-          seed: int = 0, val_fraction: float = 0.1, checkpoint_every: int = 10, resume: bool = False,
-          progress: _Progress = None, best_by: str = "rmse",
-          objective: str = "standard", inducing_init: Optional[str] = None,
-          patience: Optional[int] = None, precision: Optional[str] = None,
-          windows_per_task: Optional[int] = None,
-          lengthscale_init: Optional[float] = None) -> Prssm: ...
+def train(dataset: Dataset, out: Optional[_Path], options: list[tuple[str, str]],
+          resume: bool = False, progress: _Progress = None) -> Prssm: ...
 def rig_check(dataset: Dataset, reference: _Path, out: Optional[_Path] = None, particles: int = 30,
               seed: int = 1, lags: bool = True, progress: _Progress = None) -> str: ...
 def evaluate(dataset: Dataset, out: _Path, prssm: Optional[Prssm] = None, lrqsm: Optional[Lrqsm] = None,
