@@ -20,7 +20,9 @@
 //! | [`wang2004`] | the published 2-D hovering experiment (Wang, Birch & Dickinson 2004) beside every fidelity |
 //! | [`sysid`] | Doerr et al. system-identification protocol (fit, open-loop test, RMSE/NLL) |
 //!
-//! Shared pieces: [`error`] (one error type naming the file, trajectory or stage), [`progress`]
+//! Shared pieces: [`presets`] (the named training presets: paper, paper-fast, sysid),
+//! [`adapters`] (datasets to the engine's sequences), [`error`] (one error type naming the
+//! file, trajectory or stage), [`progress`]
 //! (the progress sink a caller supplies), [`resources`] (memory estimates checked before any
 //! work), [`seed`] (the one seed-derivation rule), [`files`]
 //! (atomic JSON and text files), [`threads`] (the pool a job runs on).

@@ -5,7 +5,7 @@ use std::path::Path;
 
 use plotters::prelude::*;
 
-use super::{bold, font, model_colour, padded_range, render};
+use super::{bold, draw_legend, font, model_colour, padded_range, render};
 use crate::error::{AnalysisError, Result};
 use crate::metrics::Histogram;
 use crate::stats::central_interval;
@@ -123,11 +123,7 @@ pub fn error_histograms(
                 }
             }
             if j == 0 {
-                ch.configure_series_labels()
-                    .position(SeriesLabelPosition::UpperLeft)
-                    .label_font(font(12.0))
-                    .background_style(WHITE.mix(0.9))
-                    .draw()?;
+                draw_legend(&mut ch, SeriesLabelPosition::UpperLeft, 12.0)?;
             }
         }
         Ok::<(), Box<dyn std::error::Error>>(())
@@ -267,11 +263,7 @@ pub fn cycle_average_scatter(
                 }
             }
             if j == 0 {
-                ch.configure_series_labels()
-                    .position(SeriesLabelPosition::UpperLeft)
-                    .label_font(font(12.0))
-                    .background_style(WHITE.mix(0.9))
-                    .draw()?;
+                draw_legend(&mut ch, SeriesLabelPosition::UpperLeft, 12.0)?;
             }
         }
         Ok::<(), Box<dyn std::error::Error>>(())

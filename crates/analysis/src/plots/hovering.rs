@@ -4,7 +4,7 @@ use std::path::Path;
 
 use plotters::prelude::*;
 
-use super::{PALETTE, bold, font, padded_range, render};
+use super::{PALETTE, bold, draw_legend, font, padded_range, render};
 use crate::error::{AnalysisError, Result};
 
 /// One source's histories.
@@ -94,12 +94,7 @@ pub fn lift_drag<'a>(
                     .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], style));
             }
             if r == 0 {
-                ch.configure_series_labels()
-                    .position(SeriesLabelPosition::UpperRight)
-                    .label_font(font(12.0))
-                    .background_style(WHITE.mix(0.85))
-                    .border_style(RGBColor(200, 200, 200))
-                    .draw()?;
+                draw_legend(&mut ch, SeriesLabelPosition::UpperRight, 12.0)?;
             }
         }
         Ok::<(), Box<dyn std::error::Error>>(())

@@ -209,6 +209,21 @@ pub(crate) fn font(size: f64) -> TextStyle<'static> {
     (FONT, size).into_font().into()
 }
 
+/// Draws the legend of `ch`'s labelled series at `position` in the plots' one style: the
+/// embedded font at `size`, a white box at 85 % and a light grey border.
+pub(crate) fn draw_legend<'a, DB: DrawingBackend + 'a, CT: CoordTranslate>(
+    ch: &mut ChartContext<'a, DB, CT>,
+    position: SeriesLabelPosition,
+    size: f64,
+) -> std::result::Result<(), DrawingAreaErrorKind<DB::ErrorType>> {
+    ch.configure_series_labels()
+        .position(position)
+        .label_font(font(size))
+        .background_style(WHITE.mix(0.85))
+        .border_style(RGBColor(200, 200, 200))
+        .draw()
+}
+
 /// A bold text style of the embedded font.
 pub(crate) fn bold(size: f64) -> TextStyle<'static> {
     (FONT, size, FontStyle::Bold).into_font().into()

@@ -5,7 +5,7 @@ use std::path::Path;
 
 use plotters::prelude::*;
 
-use super::{PALETTE, bold, font, padded_range, render};
+use super::{PALETTE, bold, draw_legend, font, padded_range, render};
 use crate::error::{AnalysisError, Result};
 use crate::rig::CHANNELS;
 
@@ -120,12 +120,7 @@ pub fn rig_overlay(
                     PathElement::new(vec![(x, y), (x + 18, y)], BLACK.stroke_width(3))
                 });
                 if c == 0 && k == 0 {
-                    ch.configure_series_labels()
-                        .position(SeriesLabelPosition::UpperLeft)
-                        .label_font(font(11.0))
-                        .background_style(WHITE.mix(0.85))
-                        .border_style(RGBColor(200, 200, 200))
-                        .draw()?;
+                    draw_legend(&mut ch, SeriesLabelPosition::UpperLeft, 11.0)?;
                 }
             }
         }

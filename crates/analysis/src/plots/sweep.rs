@@ -5,7 +5,7 @@ use std::path::Path;
 
 use plotters::prelude::*;
 
-use super::{PALETTE, bold, font, padded_range, render};
+use super::{PALETTE, bold, draw_legend, font, padded_range, render};
 use crate::error::Result;
 
 /// One run of a sweep: the swept value and its overall RMSEs (σ units).
@@ -102,11 +102,7 @@ pub fn accuracy_vs_setting(path: &Path, panels: &[SweepPanel<'_>]) -> Result<()>
                         .map(|&(x, y)| Circle::new((x, y), 4, col.filled())),
                 )?;
             }
-            ch.configure_series_labels()
-                .label_font(font(14.0))
-                .background_style(WHITE.mix(0.85))
-                .border_style(RGBColor(180, 180, 180))
-                .draw()?;
+            draw_legend(&mut ch, SeriesLabelPosition::MiddleRight, 14.0)?;
         }
         Ok::<(), Box<dyn std::error::Error>>(())
     })

@@ -6,7 +6,7 @@ use std::path::Path;
 
 use plotters::prelude::*;
 
-use super::{PALETTE, bold, font, padded_range, render};
+use super::{PALETTE, bold, draw_legend, font, padded_range, render};
 use crate::error::{AnalysisError, Result};
 
 /// Draws the test-part prediction into `path` (`.png`/`.svg`, 1000 × 320 px per output).
@@ -83,12 +83,7 @@ pub fn plot_test_prediction(
             ))?
             .label("measured")
             .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], BLACK.stroke_width(3)));
-            ch.configure_series_labels()
-                .position(SeriesLabelPosition::UpperRight)
-                .label_font(font(13.0))
-                .background_style(WHITE.mix(0.85))
-                .border_style(RGBColor(200, 200, 200))
-                .draw()?;
+            draw_legend(&mut ch, SeriesLabelPosition::UpperRight, 13.0)?;
         }
         Ok::<(), Box<dyn std::error::Error>>(())
     })

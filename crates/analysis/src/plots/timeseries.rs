@@ -11,7 +11,7 @@ use std::path::Path;
 
 use plotters::prelude::*;
 
-use super::{PALETTE, bold, font, model_colour, padded_range, render};
+use super::{PALETTE, bold, draw_legend, font, model_colour, padded_range, render};
 use crate::error::{AnalysisError, Result};
 
 /// Coefficient curves of one source (measurement or model).
@@ -199,11 +199,7 @@ pub fn time_histories<'a>(
                         PathElement::new(vec![(x, y), (x + 18, y)], col.stroke_width(3))
                     });
                 }
-                ch.configure_series_labels()
-                    .position(SeriesLabelPosition::UpperRight)
-                    .label_font(font(12.0))
-                    .background_style(WHITE.mix(0.85))
-                    .draw()?;
+                draw_legend(&mut ch, SeriesLabelPosition::UpperRight, 12.0)?;
             }
             // Rows 2, 3: C_Fx, C_Fy.
             for (row, comp) in [(2usize, 0usize), (3, 1)] {
@@ -278,11 +274,7 @@ pub fn time_histories<'a>(
                     PathElement::new(vec![(x, y), (x + 18, y)], BLACK.stroke_width(3))
                 });
                 if c == 0 && row == 2 {
-                    ch.configure_series_labels()
-                        .position(SeriesLabelPosition::UpperLeft)
-                        .label_font(font(12.0))
-                        .background_style(WHITE.mix(0.85))
-                        .draw()?;
+                    draw_legend(&mut ch, SeriesLabelPosition::UpperLeft, 12.0)?;
                 }
             }
         }

@@ -4,7 +4,7 @@ use std::path::Path;
 
 use plotters::prelude::*;
 
-use super::{PALETTE, bold, font, padded_range, render};
+use super::{PALETTE, bold, draw_legend, font, padded_range, render};
 use crate::error::{AnalysisError, Result};
 
 /// One training curve.
@@ -95,10 +95,6 @@ where
             .label(c.label)
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], col.stroke_width(3)));
     }
-    ch.configure_series_labels()
-        .label_font(font(15.0))
-        .background_style(WHITE.mix(0.85))
-        .border_style(RGBColor(180, 180, 180))
-        .draw()?;
+    draw_legend(ch, SeriesLabelPosition::MiddleRight, 15.0)?;
     Ok(())
 }
