@@ -67,7 +67,7 @@ pub fn predict_step_flops(config: &ModelConfig, particles: usize) -> f64 {
     2.0 * (m + dx) * m * p + 2.0 * dx * m * p + 2.0 * m * dx * p
 }
 
-/// The part of [`train_step_flops`] that [`Precision::Mixed`] runs in `f32`: the three large
+/// The part of [`train_step_flops`] that [`Precision::Mixed`](crate::Precision::Mixed) runs in `f32`: the three large
 /// products with their `D_x` mean rows and the three `D_x`-row variance products
 /// (`6 M² N + 12 M D_x N`); the kernel's distances and their adjoint products stay `f64`.
 pub fn train_step_f32_flops(config: &ModelConfig, n_points: usize) -> f64 {

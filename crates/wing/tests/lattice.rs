@@ -273,7 +273,7 @@ fn wake_capture(n: usize) -> (f64, f64, f64) {
 /// (docs/vortex-method.md, "Current figures"). `cargo test --release -p flapssm-wing --test lattice
 /// l3_wake_capture_study -- --ignored --nocapture`.
 #[test]
-#[ignore = "measurement (a few minutes); reported in docs/vortex-method.md"]
+#[ignore = "measurement (a few minutes); run by scripts/wing_studies.py, output in docs/lab/wing-studies.md"]
 fn l3_wake_capture_study() {
     let (a, b, q) = wake_capture(548);
     println!(

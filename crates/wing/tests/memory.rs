@@ -445,7 +445,7 @@ fn trailing_edge_leads_as_often_as_in_the_papers_trajectories() {
 /// data, for the record (docs/vortex-method.md; L3's are printed by `l3_memory_evidence`). A study, not a check:
 /// `cargo test --release -p flapssm-wing --test memory -- --ignored --nocapture`.
 #[test]
-#[ignore = "study: prints the L2 memory figures of the flat normal-force wing (≈ 10 s)"]
+#[ignore = "study: prints the L2 memory figures of the flat normal-force wing (≈ 10 s); run by scripts/wing_studies.py, output in docs/lab/wing-studies.md"]
 fn study_l2_memory_evidence() {
     memory(Set::FlatHovering, Chordwise::FrictionOnly, Fidelity::L2);
 }
@@ -455,7 +455,7 @@ fn study_l2_memory_evidence() {
 /// check: `cargo test --release -p flapssm-wing --test memory paper_memory_study -- --ignored
 /// --nocapture`.
 #[test]
-#[ignore = "study: memory evidence on the paper's trajectories"]
+#[ignore = "study: memory evidence on the paper's trajectories; run by scripts/wing_studies.py, output in docs/lab/wing-studies.md"]
 fn paper_memory_study() {
     memory(Set::Paper, Chordwise::Full, Fidelity::L1);
     memory(Set::Paper, Chordwise::Full, Fidelity::L2);

@@ -845,7 +845,7 @@ fn l2_outputs_are_insensitive_to_a_small_parameter_change() {
 /// study, not a check: `cargo test --release -p flapssm-wing --test physics
 /// l2_sensitivity_study -- --ignored --nocapture`.
 #[test]
-#[ignore = "study: prints the L2 sensitivity on the default and the paper's kinematics"]
+#[ignore = "study: prints the L2 sensitivity on the default and the paper's kinematics; run by scripts/wing_studies.py, output in docs/lab/wing-studies.md"]
 fn l2_sensitivity_study() {
     let [d, p] = l2_sensitivity(&l2_config());
     println!("default generator: rms change from r_c0 × 1.001 (σ): {d:.3?}");
@@ -917,7 +917,7 @@ fn l2_sensitivity(base: &VirtualWingConfig) -> [[f64; 5]; 2] {
 /// study, not a check: `cargo test --release -p flapssm-wing --test physics l2_burst_study --
 /// --ignored --nocapture`.
 #[test]
-#[ignore = "study: counts L2 bursts on three trajectory sets"]
+#[ignore = "study: counts L2 bursts on three trajectory sets; run by scripts/wing_studies.py, output in docs/lab/wing-studies.md"]
 fn l2_burst_study() {
     for (name, bursts, worst) in l2_bursts(&l2_config(), true) {
         println!(
@@ -986,7 +986,7 @@ fn l2_bursts(l2: &VirtualWingConfig, hovering: bool) -> Vec<(&'static str, usize
 /// A study, not a check: `cargo test --release -p flapssm-wing --test physics
 /// repeatability_study -- --ignored --nocapture`.
 #[test]
-#[ignore = "study: loads from two histories of the same kinematics"]
+#[ignore = "study: loads from two histories of the same kinematics; run by scripts/wing_studies.py, output in docs/lab/wing-studies.md"]
 fn repeatability_study() {
     for fidelity in [Fidelity::L1, Fidelity::L2] {
         let cfg = VirtualWingConfig {
@@ -1082,7 +1082,7 @@ fn l2_frozen_wake_is_not_chaotic() {
 /// 3rd cycles and the bursts. A study, not a check: `cargo test --release -p flapssm-wing --test
 /// physics l2_wake_motion_study -- --ignored --nocapture` (≈ 8 min on 2 cores).
 #[test]
-#[ignore = "study: the free and the frozen wake on the three criteria"]
+#[ignore = "study: the free and the frozen wake on the three criteria; run by scripts/wing_studies.py, output in docs/lab/wing-studies.md"]
 fn l2_wake_motion_study() {
     let uniform = |ratio| Inflow::Uniform { ratio };
     let variants = [
@@ -1120,7 +1120,7 @@ fn l2_wake_motion_study() {
 /// histories per cycle, bursts. A study, not a check: `cargo test --release -p flapssm-wing --test physics l3_study --
 /// --ignored --nocapture`.
 #[test]
-#[ignore = "study: the L3 vortex lattice on the criteria of a rig's loads"]
+#[ignore = "study: the L3 vortex lattice on the criteria of a rig's loads; run by scripts/wing_studies.py, output in docs/lab/wing-studies.md"]
 fn l3_study() {
     let cfg = VirtualWingConfig {
         fidelity: Fidelity::L3,

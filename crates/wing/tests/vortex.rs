@@ -651,7 +651,7 @@ fn kelvin_total_circulation_is_zero_without_decay() {
 /// Measurement (ignored, open gap): 2-D hover, |C_N| (smoothed over 1/300 cycle) at 600, 1200
 /// and 2400 steps per cycle.
 #[test]
-#[ignore = "measurement of an open gap (docs/vortex-method.md)"]
+#[ignore = "measurement of an open gap (docs/vortex-method.md); run by scripts/wing_studies.py, output in docs/lab/wing-studies.md"]
 fn study_hover_spikes() {
     let h = Hover {
         c: 0.06,
@@ -901,7 +901,7 @@ fn wake_capture_measure() -> (f64, f64, f64) {
 
 /// Measurement (ignored, open gap): wake capture at r_cp, with and without the wake.
 #[test]
-#[ignore = "measurement of an open gap (docs/vortex-method.md)"]
+#[ignore = "measurement of an open gap (docs/vortex-method.md); run by scripts/wing_studies.py, output in docs/lab/wing-studies.md"]
 fn study_wake_capture() {
     let (a, b, q) = wake_capture_measure();
     println!("after reversal: (L2 − QS) {a:.4} N/m with wake, {b:.4} N/m wake deleted; QS {q:.4}");
@@ -909,7 +909,7 @@ fn study_wake_capture() {
 
 /// Measurement (ignored, open gap): per-cycle peak |C_Fx| of the L2 Robofly hover.
 #[test]
-#[ignore = "measurement of an open gap (docs/vortex-method.md)"]
+#[ignore = "measurement of an open gap (docs/vortex-method.md); run by scripts/wing_studies.py, output in docs/lab/wing-studies.md"]
 fn study_wing_hover_trace() {
     let (states, dt) = hover_states(F_HOVER, 4);
     let y = run_blade(&states, dt, 2);
@@ -1107,7 +1107,7 @@ fn wake_capture_on_paper(n: usize) -> (f64, f64, f64, usize, usize) {
 /// "Wake capture on the default data"). `cargo test --release -p flapssm-wing --test vortex
 /// study_wake_capture_paper -- --ignored --nocapture`.
 #[test]
-#[ignore = "measurement (about a minute); reported in docs/vortex-method.md"]
+#[ignore = "measurement (about a minute); run by scripts/wing_studies.py, output in docs/lab/wing-studies.md"]
 fn study_wake_capture_paper() {
     let (a, b, q, m, pos) = wake_capture_on_paper(548);
     println!(
@@ -1249,7 +1249,7 @@ fn rotating_plate_chordwise_force_equals_the_impulse() {
 /// suction held at ρπc(LESP_crit·U)²) against the impulse's, smoothed over ±0.075 t*, at two
 /// time steps.
 #[test]
-#[ignore]
+#[ignore = "study: the chordwise force with LEV shedding at two time steps; run by scripts/wing_studies.py, output in docs/lab/wing-studies.md"]
 fn study_chordwise_force_with_lev_shedding() {
     for dt in [0.015, 0.0075] {
         let r = eldredge_run_with(eldredge, dt);
@@ -1326,7 +1326,7 @@ fn strip_peaks(states: &[EulerState], dt: f64, trace: bool) -> (f64, f64, usize,
 /// (docs/vortex-method.md, "Open gaps"). A study: `cargo test --release -p flapssm-wing --test
 /// vortex study_strip_bursts_paper -- --ignored --nocapture` (about 20 s).
 #[test]
-#[ignore = "study: bursts of the L2 strip on the paper's trajectories"]
+#[ignore = "study: bursts of the L2 strip on the paper's trajectories; run by scripts/wing_studies.py, output in docs/lab/wing-studies.md"]
 fn study_strip_bursts_paper() {
     use flapssm_wing::trajectories::SamplingConfig;
     use flapssm_wing::trajectories::measured::raw_states;
