@@ -94,6 +94,17 @@ pub enum JobError {
         /// Found, in words.
         found: String,
     },
+    /// A rig description is at fault (names the file and the field).
+    #[error("{path}: {source}")]
+    Rig {
+        /// The rig description.
+        path: PathBuf,
+        /// Cause.
+        source: flapssm_wing::rig::RigError,
+    },
+    /// A recording cannot be processed (names the file, and the column, row or field).
+    #[error(transparent)]
+    Recording(flapssm_wing::rig::RigError),
     /// A file could not be read or written.
     #[error("{path}: {source}")]
     Io {

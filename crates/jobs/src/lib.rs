@@ -13,6 +13,7 @@
 //! | [`models`] | the load models behind one trait (PR-SSM, LRQSM, ARX) |
 //! | [`evaluate`] | both models on a dataset: metrics, authority, figures, report |
 //! | [`rig`] | a dataset on the paper's trajectories against the published model's prediction of the rig's loads |
+//! | [`own_rig`] | a user's rig: its description, raw recordings into a dataset, the virtual wing rehearsing it |
 //! | [`sweep`] | one-configuration PR-SSM sweep runs (D_x, training-set size) and their merge |
 //! | [`demo`] | the one-command demo: simulate, fit, train, evaluate (resumable) |
 //! | [`bench`](mod@bench) | the engine's speed in the paper's configuration beside the authors' code |
@@ -37,6 +38,7 @@ pub mod evaluate;
 pub mod files;
 pub mod kinematics_compare;
 pub mod models;
+pub mod own_rig;
 pub mod predict;
 pub mod presets;
 pub mod progress;

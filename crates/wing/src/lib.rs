@@ -15,6 +15,7 @@ pub mod hovering2d;
 pub mod kinematics;
 pub mod lattice;
 pub mod mount;
+pub mod rig;
 pub mod sensor;
 pub mod trajectories;
 mod vec3;

@@ -27,6 +27,7 @@ use crate::error::{AnalysisError, Result};
 pub mod authority;
 pub mod errors;
 pub mod hovering;
+pub mod processing;
 pub mod rig;
 pub mod sweep;
 pub mod sysid;

@@ -1,12 +1,14 @@
 //! `flapssm simulate`: run the virtual robotic wing on the seeded generator's trajectories or on
 //! the paper's measured ones, and write a dataset.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::Context;
 use clap::Args;
 use flapssm_jobs::NoProgress;
+use flapssm_jobs::files::{check_output_dir, check_outputs};
+use flapssm_jobs::own_rig::{RehearsalSettings, load_rig, rehearsal_file_name, rehearse_rig};
 use flapssm_jobs::simulate::{SimulateSettings, simulate, simulate_paper};
 use flapssm_wing::virtual_wing::Fidelity;
 
@@ -19,9 +21,10 @@ pub struct SimulateArgs {
     /// Trajectories: the seeded generator, or the paper's measured set.
     #[arg(long, value_enum, default_value = "generator")]
     source: SourceArg,
-    /// Number of trajectories (with --source paper: the first N of 548).
-    #[arg(long, value_name = "N", default_value_t = 548)]
-    n: usize,
+    /// Number of trajectories (with --source paper: the first N of 548); default 548, with
+    /// --rig 10 recordings.
+    #[arg(long, value_name = "N")]
+    n: Option<usize>,
     /// Seed of the generated trajectories and of the sensor noise (same seed → identical file).
     #[arg(long, value_name = "S", default_value_t = 0)]
     seed: u64,
@@ -57,13 +60,71 @@ pub struct SimulateArgs {
     /// momentum at L3. Refused at L0 and L1.
     #[arg(long, value_name = "INFLOW")]
     inflow: Option<String>,
+    /// Rehearse a rig (its description, TOML; docs/own-rig.md): write the raw recordings it
+    /// would make of generated motions into --recordings, and to --out the virtual wing's own
+    /// loads on them, the answer that `flapssm dataset build` should recover.
+    #[arg(long, value_name = "FILE", requires = "recordings",
+          conflicts_with_all = ["wing_config", "noise_free", "flat", "wake", "inflow"])]
+    rig: Option<PathBuf>,
+    /// With --rig: the directory of the raw recordings (recording_000.csv, …).
+    #[arg(long, value_name = "DIR", requires = "rig")]
+    recordings: Option<PathBuf>,
+    /// With --rig: the length of each motion after the move from the home pose (s).
+    #[arg(long, value_name = "SECONDS", default_value_t = 16.0, requires = "rig")]
+    motion_s: f64,
     /// Hide the progress bar.
     #[arg(long)]
     quiet: bool,
 }
 
+/// `flapssm simulate --rig`: a rig rehearsed by the virtual wing.
+fn rehearse(args: &SimulateArgs, rig: &Path, dir: &Path) -> anyhow::Result<()> {
+    let start = Instant::now();
+    let n = args.n.unwrap_or(RehearsalSettings::default().n_recordings);
+    let names: Vec<String> = (0..n).map(rehearsal_file_name).collect();
+    let names: Vec<&str> = names.iter().map(String::as_str).collect();
+    check_outputs(&[&args.out], &[rig])?;
+    check_output_dir(dir, &names, &[rig, &args.out])?;
+    let desc = load_rig(rig)?;
+    let fidelity: Fidelity = args
+        .fidelity
+        .as_deref()
+        .map(|f| f.parse().context("parsing --fidelity"))
+        .transpose()?
+        .unwrap_or(Fidelity::L0);
+    let settings = RehearsalSettings {
+        n_recordings: n,
+        seed: args.seed,
+        fidelity,
+        motion_s: args.motion_s,
+        n_train: args.n_train,
+    };
+    let bars = Bars::new();
+    let progress: &dyn flapssm_jobs::Progress = if args.quiet { &NoProgress } else { &bars };
+    let truth = rehearse_rig(&desc, rig, &settings, dir, progress)?;
+    truth
+        .save(&args.out)
+        .with_context(|| format!("writing dataset {}", args.out.display()))?;
+    println!(
+        "wrote {n} raw recordings of the rig '{}' ({} Hz, fidelity {fidelity:?}, seed {}) to {}, \
+         and the wing's own loads on them to {} ({} trajectories × {} samples) in {:.2} s",
+        desc.name,
+        desc.sampling.rate_hz,
+        args.seed,
+        dir.display(),
+        args.out.display(),
+        truth.len(),
+        truth.n_samples(),
+        start.elapsed().as_secs_f64()
+    );
+    Ok(())
+}
+
 /// Runs `flapssm simulate`.
 pub fn run(args: SimulateArgs) -> anyhow::Result<()> {
+    if let (Some(rig), Some(dir)) = (&args.rig, &args.recordings) {
+        return rehearse(&args, rig, dir);
+    }
     let start = Instant::now();
     let inputs: Vec<&std::path::Path> = args.wing_config.iter().map(|p| p.as_path()).collect();
     flapssm_jobs::files::check_outputs(&[&args.out], &inputs)?;
@@ -80,7 +141,7 @@ pub fn run(args: SimulateArgs) -> anyhow::Result<()> {
         })
         .transpose()?;
     let settings = SimulateSettings {
-        n_trajectories: args.n,
+        n_trajectories: args.n.unwrap_or(548),
         n_train: args.n_train,
         seed: args.seed,
         wing,
