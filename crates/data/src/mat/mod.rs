@@ -1,5 +1,5 @@
-//! MATLAB `.mat` readers: Level 4 (v4) and Level 5 (v5, v6, v7 incl. zlib-compressed
-//! `miCOMPRESSED` elements). Not HDF5-based v7.3 files.
+//! MATLAB `.mat` readers: Level 4 (v4), Level 5 (v5, v6, v7 incl. zlib-compressed
+//! `miCOMPRESSED` elements) and the HDF5-based v7.3.
 //!
 //! Supported variables: numeric full arrays of any class (double, single, int8…uint64, also
 //! logical), any number of dimensions, stored in any numeric type (e.g. a double array saved as
@@ -15,6 +15,7 @@ use std::path::{Path, PathBuf};
 
 mod v4;
 mod v5;
+mod v73;
 
 /// Errors reading a `.mat` file.
 #[derive(Debug, thiserror::Error)]
@@ -88,6 +89,8 @@ pub enum MatVersion {
     V4,
     /// Level 5 (`-v6`, `-v7`; `-v7` compresses each variable).
     V5,
+    /// HDF5-based (`-v7.3`, the default of many installations).
+    V73,
 }
 
 /// MATLAB class of a numeric variable.
@@ -199,7 +202,15 @@ impl MatFile {
         let is_v5 = bytes.len() >= 128
             && (&bytes[126..128] == b"IM" || &bytes[126..128] == b"MI")
             && bytes[..4].iter().all(|&b| b != 0);
-        if is_v5 {
+        // v7.3: the same 128-byte header, version 0x0200, HDF5 from byte 512.
+        let is_v73 = is_v5
+            && bytes.len() > 520
+            && u16::from_le_bytes([bytes[124], bytes[125]]) == 0x0200
+            && &bytes[512..520] == b"\x89HDF\r\n\x1a\n";
+        if is_v73 {
+            file.version = MatVersion::V73;
+            file.parse_v73(bytes, options)?;
+        } else if is_v5 {
             file.version = MatVersion::V5;
             file.parse_v5(bytes, options)?;
         } else {
@@ -413,6 +424,52 @@ mod tests {
             .skip(1)
             .map(|l| l.split(',').nth(col).unwrap().trim().parse().unwrap())
             .collect()
+    }
+
+    /// The HDF5-based v7.3 layout (fixture from make_v73.py: the classes of classes_v5.mat,
+    /// MATLAB's attributes and transposed storage, a deflated chunked column).
+    #[test]
+    fn all_classes_v73() {
+        let m = MatFile::read(fixture("classes_v73.mat")).unwrap();
+        assert_eq!(m.version, MatVersion::V73);
+        let d3 = m.get("d3").unwrap();
+        assert_eq!(d3.dims, vec![2, 3, 4]);
+        assert_eq!(d3.data, (0..24).map(f64::from).collect::<Vec<_>>());
+        let s2 = m.get("s2").unwrap();
+        assert_eq!(
+            (s2.class, s2.dims.as_slice()),
+            (MatClass::Single, &[2, 3][..])
+        );
+        assert_eq!(s2.data, vec![1.5, -2.25, 3.0, 4.0, 5.0, -6.5]);
+        let two53 = 2f64.powi(53);
+        for (name, class, vals) in [
+            ("i8", MatClass::Int8, [-128.0, 0.0, 127.0]),
+            ("u16", MatClass::Uint16, [0.0, 9.0, 65535.0]),
+            ("i32", MatClass::Int32, [-2147483648.0, 11.0, 2147483647.0]),
+            ("u64", MatClass::Uint64, [0.0, 17.0, two53]),
+            ("i64", MatClass::Int64, [-two53, 15.0, two53]),
+        ] {
+            let v = m.get(name).unwrap();
+            assert_eq!((v.class, v.dims.as_slice()), (class, &[1, 3][..]), "{name}");
+            assert_eq!(v.data, vals, "{name}");
+        }
+        let b = m.get("b").unwrap();
+        assert!(b.logical);
+        let col = m.get("col").unwrap();
+        assert_eq!(col.dims, vec![1000, 1]);
+        assert!(
+            col.data
+                .iter()
+                .enumerate()
+                .all(|(k, v)| *v == k as f64 / 8.0)
+        );
+        let mut skipped: Vec<&str> = m.skipped.iter().map(|(n, _)| n.as_str()).collect();
+        skipped.sort();
+        assert_eq!(skipped, vec!["st", "txt"]);
+        assert!(m.get("txt").unwrap_err().to_string().contains("char"));
+        // A table of its columns, as a rig recording is read.
+        let t = crate::table::Table::read_mat(&fixture("classes_v73.mat"), &["col", "s2"]);
+        assert!(t.is_err(), "columns of different lengths are refused");
     }
 
     #[test]
