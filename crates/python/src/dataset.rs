@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 
 use flapssm_jobs::simulate::SimulateSettings;
-use flapssm_wing::cycles::{U_REF_RADIUS_M, published_u_ref};
+use flapssm_wing::cycles::published_u_ref;
 use flapssm_wing::dataset::{Dataset as WingDataset, DatasetMeta, Trajectory, ValidDataset};
 use flapssm_wing::virtual_wing::{Fidelity, VirtualWingConfig};
 use numpy::{
@@ -58,10 +58,12 @@ impl Dataset {
     }
 
     /// A dataset from arrays (checked by the Python layer for dtype and shape; validated
-    /// here: finite values, equal lengths). `u_ref_m_s` defaults to the published rule
-    /// (mean speed at the wing tip over the last full cycle).
+    /// here: finite values, equal lengths), of the rig of the description `rig` (a file) or
+    /// `rig_json` (a dict), or else the paper's wing. `u_ref_m_s` defaults to the published
+    /// rule (mean speed at the rig's `u_ref_radius_m` over the last full cycle).
     #[staticmethod]
-    #[pyo3(signature = (euler_rad, inputs, outputs, n_train, dt_s, u_ref_m_s=None))]
+    #[pyo3(signature = (euler_rad, inputs, outputs, n_train, dt_s, u_ref_m_s=None, rig=None, rig_json=None))]
+    #[allow(clippy::too_many_arguments)]
     fn from_arrays(
         euler_rad: PyReadonlyArray3<'_, f64>,
         inputs: PyReadonlyArray3<'_, f64>,
@@ -69,7 +71,21 @@ impl Dataset {
         n_train: usize,
         dt_s: f64,
         u_ref_m_s: Option<PyReadonlyArray1<'_, f64>>,
+        rig: Option<PathBuf>,
+        rig_json: Option<&str>,
     ) -> PyResult<Self> {
+        let desc = if rig.is_some() || rig_json.is_some() {
+            Some(crate::own_rig::rig_of(rig.as_deref(), rig_json)?.0)
+        } else {
+            None
+        };
+        let mut meta = DatasetMeta::new("python arrays", None, serde_json::Value::Null);
+        if let Some(d) = &desc {
+            meta.wing = d.geometry();
+            meta.fluid = d.fluid();
+            meta.settings = serde_json::json!({ "rig": d });
+        }
+        let radius = meta.wing.u_ref_radius_m;
         let e = euler_rad.as_slice()?;
         let u = inputs.as_slice()?;
         let y = outputs.as_ref().map(|o| o.as_slice()).transpose()?;
@@ -102,7 +118,7 @@ impl Dataset {
             let u_ref = match u_ref {
                 Some(r) => r[i],
                 None => {
-                    published_u_ref(&euler, dt_s, U_REF_RADIUS_M)
+                    published_u_ref(&euler, dt_s, radius)
                         .map_err(|err| {
                             PyValueError::new_err(format!("trajectory {i}: U_ref: {err}"))
                         })?
@@ -118,7 +134,7 @@ impl Dataset {
             });
         }
         let ds = WingDataset {
-            meta: DatasetMeta::new("python arrays", None, serde_json::Value::Null),
+            meta,
             dt_s,
             trajectories,
             n_train,

@@ -6,6 +6,7 @@ mod dataset;
 mod errors;
 mod evaluate;
 mod lrqsm;
+mod own_rig;
 mod progress;
 mod prssm;
 mod rig;
@@ -32,6 +33,10 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     )?;
     m.add_function(wrap_pyfunction!(evaluate::evaluate, m)?)?;
     m.add_function(wrap_pyfunction!(rig::rig_check, m)?)?;
+    m.add_function(wrap_pyfunction!(own_rig::rig_template, m)?)?;
+    m.add_function(wrap_pyfunction!(own_rig::load_rig_description, m)?)?;
+    m.add_function(wrap_pyfunction!(own_rig::build_dataset, m)?)?;
+    m.add_function(wrap_pyfunction!(own_rig::rehearse_rig, m)?)?;
     m.add("INPUT_NAMES", flapssm_wing::dataset::INPUT_NAMES.to_vec())?;
     m.add("OUTPUT_NAMES", flapssm_wing::dataset::OUTPUT_NAMES.to_vec())?;
     m.add("INPUT_UNITS", flapssm_wing::dataset::INPUT_UNITS.to_vec())?;

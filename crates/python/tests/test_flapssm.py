@@ -26,12 +26,13 @@ def test_dataset_round_trips_through_files_and_arrays(small, tmp_path):
     assert small.inputs.shape == (4, 470, 7) and small.inputs.dtype == np.float64
 
     made = flapssm.dataset_from_arrays(small.euler_rad, small.inputs, small.outputs, n_train=3,
-                                       u_ref_m_s=small.u_ref_m_s)
+                                       u_ref_m_s=small.u_ref_m_s, rig="paper")
     made.save(tmp_path / "made.npz")
     again = flapssm.Dataset.load(tmp_path / "made.npz")
     assert np.array_equal(again.outputs, small.outputs)
     # U_ref by the published rule when not given: the simulator's own value.
-    derived = flapssm.dataset_from_arrays(small.euler_rad, small.inputs, small.outputs)
+    with pytest.warns(UserWarning, match="the paper's wing is assumed"):
+        derived = flapssm.dataset_from_arrays(small.euler_rad, small.inputs, small.outputs)
     assert np.allclose(derived.u_ref_m_s, small.u_ref_m_s, rtol=1e-12)
 
 
@@ -81,13 +82,13 @@ def test_bad_input_raises_the_right_exception(small, tmp_path):
     with pytest.raises(ValueError, match="garbage.npz"):
         flapssm.Dataset.load(garbage)
     with pytest.raises(ValueError, match=r"inputs: shape \(4, 470, 6\), expected \(4, 470, 7\)"):
-        flapssm.dataset_from_arrays(small.euler_rad, small.inputs[:, :, :6])
+        flapssm.dataset_from_arrays(small.euler_rad, small.inputs[:, :, :6], rig="paper")
     with pytest.raises(TypeError, match="dtype"):
-        flapssm.dataset_from_arrays(small.euler_rad.astype(str), small.inputs)
+        flapssm.dataset_from_arrays(small.euler_rad.astype(str), small.inputs, rig="paper")
     nan = small.inputs.copy()
     nan[1, 7, 2] = np.nan
     with pytest.raises(ValueError, match=r"non-finite value at index \(1, 7, 2\)"):
-        flapssm.dataset_from_arrays(small.euler_rad, nan)
+        flapssm.dataset_from_arrays(small.euler_rad, nan, rig="paper")
     with pytest.raises(ValueError, match="fidelity"):
         flapssm.simulate(2, fidelity="l9")
     with pytest.raises(ValueError, match="n_train"):
@@ -182,7 +183,7 @@ def test_estimators_follow_scikit_learn_conventions(small):
     assert est.coef_.shape == (5, 11) and est.lambda_.shape == (5,)
     pred = est.predict(small.euler_rad)
     u = np.stack([flapssm.kinematics(e, 0.04) for e in small.euler_rad])
-    same = flapssm.dataset_from_arrays(small.euler_rad, u, small.outputs)
+    same = flapssm.dataset_from_arrays(small.euler_rad, u, small.outputs, rig="paper")
     assert np.array_equal(pred, flapssm.LRQSM.fit(same, n_folds=4).predict(same))
     with pytest.raises(ValueError, match=r"X: Euler angles \(n_trajectories, n_samples, 3\)"):
         est.predict(small.inputs)

@@ -1,16 +1,16 @@
 //! The evaluation pipeline against independent computations and its settings' checks.
 
 use super::*;
-use crate::models::Fit;
 use crate::models::arx::checked;
 use crate::models::lrqsm::LrqsmLoadModel;
 use crate::models::prssm::PrssmLoadModel;
+use crate::models::{Fit, ModelPrediction};
 use crate::progress::NoProgress;
 use crate::test_data::tiny_dataset;
 use crate::train::{TrainingOptions, train_prssm};
 use flapssm_analysis::authority::AuthorityConfig;
 use flapssm_qs::arx::ArxSettings;
-use flapssm_wing::cycles::published_window;
+use flapssm_wing::cycles::{published_u_ref, published_window};
 
 /// The pipeline's LRQSM errors agree with the qs crate's own RMSE (computed there from raw
 /// loads divided by σ), and its sums are consistent: overall² = mean of per-output RMSE²,
@@ -221,4 +221,50 @@ fn evaluation_settings_are_checked_and_named() {
         ..EvalOptions::default()
     });
     assert!(e.contains("authority.hdr_mass"), "{e}");
+}
+
+/// A rig's dataset is scored in the rig's coefficients: ½ρSU_ref² with its own density, area and
+/// U_ref radius (and c̄ for the moments), never the paper's — the paper's would be a factor
+/// ρ_paper S_paper / (ρ S) ≈ 1.8 (and another U_ref) away.
+#[test]
+fn coefficients_use_the_rigs_geometry() {
+    use crate::own_rig::{RIG_TEMPLATE, RehearsalSettings, parse_rig, rehearse_rig};
+    let dir = tempfile::tempdir().unwrap();
+    let source = std::path::Path::new("rig.toml");
+    let desc = parse_rig(RIG_TEMPLATE, source).unwrap();
+    let settings = RehearsalSettings {
+        n_recordings: 2,
+        motion_s: 8.0,
+        n_train: Some(1),
+        ..RehearsalSettings::default()
+    };
+    let ds = rehearse_rig(&desc, source, &settings, dir.path(), &NoProgress).unwrap();
+    let geometry = desc.geometry();
+    assert_eq!(ds.meta.wing, geometry);
+    assert_ne!(ds.meta.wing, flapssm_wing::dataset::WingGeometry::default());
+    // One "model" that predicts the measured loads.
+    let predictions: Vec<ModelPrediction> = ds
+        .trajectories
+        .iter()
+        .map(|t| ModelPrediction {
+            mean: t.outputs.as_ref().unwrap().as_flattened().to_vec(),
+            var: None,
+            latent_mean: Vec::new(),
+            wall_s: 0.0,
+        })
+        .collect();
+    let prep = scores::prepare(&ds, &[predictions]).unwrap();
+    for (t, p) in ds.trajectories.iter().zip(&prep) {
+        // U_ref at the rig's radius (the tip, 0.15 m), not the paper's 0.235 m.
+        let (u_ref, _) = published_u_ref(&t.euler_rad, ds.dt_s, geometry.u_ref_radius_m).unwrap();
+        assert_eq!(t.u_ref_m_s, u_ref);
+        let q_s = 0.5 * 1000.0 * 0.12 * 0.04 * u_ref * u_ref;
+        let y = t.outputs.as_ref().unwrap();
+        for (k, row) in y.iter().enumerate() {
+            let c = &p.measured_c[5 * k..5 * k + 5];
+            assert!((c[0] - row[0] / q_s).abs() <= 1e-12 * (1.0 + c[0].abs()));
+            assert!((c[3] - row[3] / (q_s * 0.04 * 1000.0)).abs() <= 1e-12 * (1.0 + c[3].abs()));
+            assert_eq!(&p.models[0].c[5 * k..5 * k + 5], c);
+        }
+    }
 }

@@ -60,6 +60,24 @@ pub fn parse_rig(text: &str, source: &Path) -> Result<RigDescription> {
     Ok(desc)
 }
 
+/// A rig description given as JSON (Python's dict), checked as [`load_rig`] checks a file;
+/// `source` names it in messages.
+///
+/// # Errors
+/// [`JobError::Json`] for a wrong, missing or unknown field; [`JobError::Rig`] naming a field
+/// out of range.
+pub fn rig_from_json(text: &str, source: &Path) -> Result<RigDescription> {
+    let desc: RigDescription = serde_json::from_str(text).map_err(|e| JobError::Json {
+        path: source.to_path_buf(),
+        source: e,
+    })?;
+    desc.check().map_err(|e| JobError::Rig {
+        path: source.to_path_buf(),
+        source: e,
+    })?;
+    Ok(desc)
+}
+
 /// Reads a raw recording: a CSV with a header, whitespace-separated numbers (columns named
 /// `0`, `1`, …) or a MAT file (v4, v5; a variable per column, or `name[k]` for column k of a
 /// matrix), its channels named by the rig description.

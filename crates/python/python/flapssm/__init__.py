@@ -45,6 +45,10 @@ __all__ = [
     "train",
     "evaluate",
     "rig_check",
+    "rig_template",
+    "load_rig",
+    "build_dataset",
+    "rehearse_rig",
     "LRQSMRegressor",
     "PRSSMRegressor",
 ]
@@ -57,6 +61,18 @@ LRQSM = _native.Lrqsm
 PRSSM = _native.Prssm
 
 
+RigLike = Union[str, "os.PathLike[str]", dict]
+
+
+def _rig_args(rig: RigLike) -> tuple:
+    """(path, json) of a rig description given as a file path or a dict."""
+    if isinstance(rig, dict):
+        return None, json.dumps(rig)
+    if isinstance(rig, (str, os.PathLike)):
+        return os.fspath(rig), None
+    raise TypeError(f"rig: a rig description file (str or os.PathLike) or a dict, got {type(rig).__name__}")
+
+
 def dataset_from_arrays(
     euler_rad: Any,
     inputs: Any,
@@ -64,17 +80,89 @@ def dataset_from_arrays(
     n_train: Optional[int] = None,
     dt_s: float = 0.04,
     u_ref_m_s: Any = None,
+    rig: Optional[RigLike] = None,
 ) -> "_native.Dataset":
     """A dataset from arrays: ``euler_rad`` ``(n, T, 3)``, ``inputs`` ``(n, T, 7)``,
     ``outputs`` ``(n, T, 5)`` or None, the first ``n_train`` (default all) for training,
     sampling period ``dt_s`` (s; the paper's 25 Hz: 0.04), ``u_ref_m_s`` ``(n,)`` (default:
-    the published rule from the stroke and deviation angles)."""
+    the published rule at the wing's U_ref radius from the stroke and deviation angles).
+
+    ``rig``: the rig description (a TOML file or a dict, docs/own-rig.md) whose wing, fluid and
+    U_ref radius the dataset takes — they set U_ref and every coefficient. ``"paper"`` takes the
+    paper's wing in its oil; None does too, with a ``UserWarning`` that says so."""
     e = as_float_array("euler_rad", euler_rad, (None, None, 3))
     n, t = e.shape[0], e.shape[1]
     u = as_float_array("inputs", inputs, (n, t, 7))
     y = None if outputs is None else as_float_array("outputs", outputs, (n, t, 5))
     r = None if u_ref_m_s is None else as_float_array("u_ref_m_s", u_ref_m_s, (n,))
-    return _native.Dataset.from_arrays(e, u, y, n if n_train is None else int(n_train), float(dt_s), r)
+    path = rig_json = None
+    if rig is None:
+        import warnings
+
+        warnings.warn(
+            "dataset_from_arrays: no rig given, so the paper's wing is assumed (0.18 x 0.06 m, "
+            "U_ref at 0.235 m, oil of 800 kg/m^3) for U_ref and the coefficients; pass rig= "
+            "your rig's description, or rig='paper' to say so",
+            UserWarning,
+            stacklevel=2,
+        )
+    elif not (isinstance(rig, str) and rig == "paper"):
+        path, rig_json = _rig_args(rig)
+    return _native.Dataset.from_arrays(e, u, y, n if n_train is None else int(n_train), float(dt_s), r,
+                                       path, rig_json)
+
+
+def rig_template() -> str:
+    """A documented rig description (TOML) to start from, as ``flapssm dataset rig-template``
+    writes it."""
+    return _native.rig_template()
+
+
+def load_rig(rig: RigLike) -> dict:
+    """The rig description ``rig`` (a TOML file or a dict), checked field by field (a bad or
+    unknown field raises ``ValueError`` naming it), as a dict with every default filled in."""
+    path, rig_json = _rig_args(rig)
+    return json.loads(_native.load_rig_description(path, rig_json))
+
+
+def build_dataset(
+    rig: RigLike,
+    recordings: Sequence[PathLike],
+    n_train: Optional[int] = None,
+    steps: Optional[PathLike] = None,
+    progress: Optional[Progress] = None,
+) -> "_native.Dataset":
+    """A dataset from a rig's raw recordings (``flapssm dataset build``; CSV, text or MAT
+    v4/v5/v7.3 files with the rig's angle and sensor columns), processed as the rig description
+    ``rig`` says: tare, sensor frame, subtraction of gravity, buoyancy and inertia, low-pass,
+    resampling and cutting. The dataset has the rig's wing and fluid; each recording's report
+    (tare offset, motion at rest, residual at rest) is in its metadata under
+    ``settings.recordings``. ``steps``: a directory for each recording's processing steps (CSV
+    and figure)."""
+    path, rig_json = _rig_args(rig)
+    files = [os.fspath(f) for f in recordings]
+    ds, _ = _native.build_dataset(files, path, rig_json, n_train,
+                                  None if steps is None else os.fspath(steps), progress)
+    return ds
+
+
+def rehearse_rig(
+    rig: RigLike,
+    directory: PathLike,
+    n: int = 10,
+    seed: int = 0,
+    fidelity: Optional[str] = None,
+    motion_s: float = 16.0,
+    n_train: Optional[int] = None,
+    progress: Optional[Progress] = None,
+) -> "_native.Dataset":
+    """The virtual wing as the rig ``rig`` (``flapssm simulate --rig``): writes the raw recordings
+    the rig would make of ``n`` generated motions of ``motion_s`` seconds into ``directory``
+    (``recording_000.csv``, …) and returns the wing's own loads on them, the answer
+    :func:`build_dataset` should recover. ``fidelity`` as in :func:`simulate` (default ``l0``)."""
+    path, rig_json = _rig_args(rig)
+    return _native.rehearse_rig(os.fspath(directory), path, rig_json, int(n), int(seed), fidelity,
+                                float(motion_s), n_train, progress)
 
 
 def _wing_json(wing: Optional[dict]) -> Optional[str]:

@@ -117,7 +117,9 @@ def _dataset(est: Any, X: Any, y: Any = None, n_train: Optional[int] = None) -> 
     n, t = euler.shape[:2]
     u = np.stack([flapssm.kinematics(e, est.dt_s) for e in euler])
     loads = None if y is None else _loads(y, n, t)
-    ds = flapssm.dataset_from_arrays(euler, u, loads, n_train=n_train, dt_s=est.dt_s)
+    # The estimators score loads in their own units; the wing's geometry enters only U_ref and
+    # the coefficients, which they do not use.
+    ds = flapssm.dataset_from_arrays(euler, u, loads, n_train=n_train, dt_s=est.dt_s, rig="paper")
     return ds, flat, t * N_ANGLES
 
 
