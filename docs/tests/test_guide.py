@@ -10,17 +10,18 @@ on the site) that says how the test treats it:
 
 A block without a comment fails the test, so a new command cannot slip into the guide untested.
 The blocks of a page run in order in one fresh directory, with ``target/release/flapssm`` first on
-PATH (the test command builds it before pytest runs).
+PATH (the test command builds it before pytest runs), then the Python that runs the tests.
 """
 import os
 import pathlib
 import re
 import subprocess
+import sys
 
 import pytest
 
 REPO = pathlib.Path(__file__).resolve().parents[2]
-GUIDE_PAGES = ["getting-started.md"]
+GUIDE_PAGES = ["getting-started.md", "own-rig.md"]
 FENCE = re.compile(r"^<!-- guide-test: (run|append|skip)\s*(.*?)\s*-->\n```sh\n(.*?)^```", re.M | re.S)
 ANY_SH = re.compile(r"^```sh\n", re.M)
 
@@ -46,7 +47,9 @@ def script(kind, args, body):
 def test_the_guides_commands_run(page, tmp_path):
     binary = REPO / "target" / "release" / "flapssm"
     assert binary.exists(), f"{binary} not built: run `cargo build --release -p flapssm` first"
-    env = dict(os.environ, PATH=f"{binary.parent}{os.pathsep}{os.environ['PATH']}")
+    # The built binary first on PATH, then the Python running the tests (with numpy).
+    python_bin = pathlib.Path(sys.executable).parent
+    env = dict(os.environ, PATH=os.pathsep.join([str(binary.parent), str(python_bin), os.environ["PATH"]]))
     ran = 0
     for kind, args, body in blocks(page):
         if kind == "skip":

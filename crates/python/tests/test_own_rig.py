@@ -46,7 +46,7 @@ def test_a_rehearsed_rig_builds_back_to_the_wings_loads(rig, rehearsal, tmp_path
     seen = []
     ds = flapssm.build_dataset(rig, files, steps=steps, progress=lambda *a: seen.append(a))
     assert seen and (steps / "recording_000.steps.png").is_file()
-    assert ds.outputs.shape == truth.outputs.shape and ds.dt_s == 0.01
+    assert ds.outputs.shape == truth.outputs.shape and ds.dt_s == 0.04
     for got, want in zip(ds.outputs, truth.outputs):
         rms = np.sqrt(np.mean(want ** 2, axis=0))
         scale = np.r_[[rms[:2].max()] * 2, [rms[2:].max()] * 3]
