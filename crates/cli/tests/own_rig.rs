@@ -229,3 +229,94 @@ fn bad_rigs_and_recordings_are_refused_naming_the_file_and_field() {
         &out,
     );
 }
+
+/// The rigid body identified from a rehearsed run in air replaces `[mass]`: the water
+/// recordings still build back to the wing's loads within 1 %.
+#[test]
+fn a_reference_run_in_air_replaces_the_mass_properties() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let (rig, raw, truth) = rehearsed(d, 2, "10");
+    let template = std::fs::read_to_string(&rig).unwrap();
+    let air = write(
+        d,
+        "air.toml",
+        &template.replace("density_kg_m3 = 1000.0", "density_kg_m3 = 1.204"),
+    );
+    let air_raw = d.join("air");
+    ok(&[
+        "simulate",
+        "--rig",
+        s(&air),
+        "--recordings",
+        s(&air_raw),
+        "--n",
+        "1",
+        "--motion-s",
+        "12",
+        "--seed",
+        "8",
+        "--out",
+        s(&d.join("air-truth.npz")),
+        "--quiet",
+    ]);
+    let (head, tail) = template.split_at(template.find("[mass]").unwrap());
+    let tail = &tail[tail.find("[subtract]").unwrap()..];
+    let reference = "[reference]\nrecordings = [\"air/recording_000.csv\"]\nmedium = \"air\"\nvolume_m3 = 9.6e-6\n\n";
+    let identified = write(d, "identified.toml", &format!("{head}{reference}{tail}"));
+    let out = d.join("identified.npz");
+    let mut args = vec![
+        "dataset",
+        "build",
+        "--rig",
+        s(&identified),
+        "--out",
+        s(&out),
+    ];
+    let files = recordings(&raw);
+    args.extend(files.iter().map(String::as_str));
+    let stdout = ok(&args);
+    assert!(stdout.contains("identified from"), "{stdout}");
+    let (got, want) = (Dataset::load(&out).unwrap(), Dataset::load(&truth).unwrap());
+    for (g, w) in got.trajectories.iter().zip(&want.trajectories) {
+        let (g, w) = (g.outputs.as_ref().unwrap(), w.outputs.as_ref().unwrap());
+        let scale: Vec<f64> = (0..5).map(|c| rms(w.iter().map(|r| r[c]))).collect();
+        for c in 0..5 {
+            let kind = if c < 2 {
+                scale[0].max(scale[1])
+            } else {
+                scale[2..].iter().cloned().fold(0.0, f64::max)
+            };
+            let e = rms(g.iter().zip(w).map(|(a, b)| a[c] - b[c])) / kind;
+            assert!(e < 0.01, "channel {c}: {e}");
+        }
+    }
+    assert!(
+        got.meta.settings["identified"]["inertial"]["mass_kg"]
+            .as_f64()
+            .is_some()
+    );
+    // A reference run in air without the volume cannot subtract the buoyancy.
+    let no_volume = write(
+        d,
+        "no_volume.toml",
+        &format!(
+            "{head}{}{tail}",
+            reference.replace("volume_m3 = 9.6e-6\n", "")
+        ),
+    );
+    let o = flapssm(&[
+        "dataset",
+        "build",
+        "--rig",
+        s(&no_volume),
+        "--out",
+        s(&out.with_extension("x.npz")),
+        &files[0],
+    ]);
+    assert_fails(
+        &o,
+        &["no_volume.toml", "reference.volume_m3"],
+        &out.with_extension("x.npz"),
+    );
+}

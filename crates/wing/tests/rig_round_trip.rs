@@ -2,10 +2,12 @@
 //! loads recovered from its raw recording match the wing's own (docs/own-rig.md).
 
 use flapssm_wing::dataset::Trajectory;
+use flapssm_wing::kinematics::EulerState;
+use flapssm_wing::rig::rigid_body::SensorFrame;
 use flapssm_wing::rig::{
-    AngleConvention, AngleUnit, Cutting, EulerAngle, ForceUnit, LoadFilter, MassProperties,
-    MomentUnit, RigDescription, RigError, RigFluid, RigSampling, RigWing, SensorPose, Subtract,
-    Tare, process_recording, rehearse, virtual_wing_of,
+    AngleConvention, AngleUnit, Cutting, EulerAngle, ForceUnit, LoadFilter, MassProperties, Medium,
+    MomentUnit, RawRecording, Reference, RigDescription, RigError, RigFluid, RigSampling, RigWing,
+    RigidBody, SensorPose, Subtract, Tare, identify, process_recording, rehearse, virtual_wing_of,
 };
 use flapssm_wing::trajectories::{GeneratorConfig, SamplingConfig};
 use flapssm_wing::virtual_wing::{Fidelity, VirtualWing};
@@ -79,6 +81,7 @@ fn water_rig() -> RigDescription {
                 0.0,
             ],
         }),
+        reference: None,
         subtract: Subtract {
             gravity: true,
             buoyancy: true,
@@ -132,7 +135,8 @@ fn round_trip(desc: &RigDescription, tolerance: f64) {
     for index in [0, 1] {
         let rehearsed =
             rehearse(desc, &mut wing, &motion(index), "rehearsal.csv", &mut rng).expect("rehearse");
-        let processed = process_recording(desc, &rehearsed.recording).expect("process");
+        let processed = process_recording(desc, desc.rigid_body().as_ref(), &rehearsed.recording)
+            .expect("process");
         assert_eq!(processed.trajectories.len(), 1);
         let (got, truth) = (&processed.trajectories[0], &rehearsed.truth[0]);
         let errors = relative_errors(got, truth);
@@ -180,7 +184,8 @@ fn without_the_subtraction_the_loads_are_wrong() {
     let mut rng = ChaCha8Rng::seed_from_u64(11);
     let rehearsed = rehearse(&desc, &mut wing, &motion(0), "r.csv", &mut rng).expect("rehearse");
     desc.subtract = Subtract::default();
-    let processed = process_recording(&desc, &rehearsed.recording).expect("process");
+    let processed = process_recording(&desc, desc.rigid_body().as_ref(), &rehearsed.recording)
+        .expect("process");
     let errors = relative_errors(&processed.trajectories[0], &rehearsed.truth[0]);
     assert!(errors.iter().any(|e| *e > 0.05), "{errors:?}");
 }
@@ -195,9 +200,160 @@ fn a_wing_moving_during_the_tare_is_refused() {
         .expect("rehearse")
         .recording;
     rec.angles[100][2] += 3.0;
-    let err = process_recording(&desc, &rec).unwrap_err();
+    let err = process_recording(&desc, desc.rigid_body().as_ref(), &rec).unwrap_err();
     assert!(
         matches!(&err, RigError::Recording { reason, .. } if reason.contains("rotation_deg")),
+        "{err}"
+    );
+}
+
+/// A run in air of a motion identifies the mass, centre of mass and inertia; the water run
+/// processed with them (and the given volume) comes back as with the true `[mass]`.
+#[test]
+fn an_air_run_identifies_the_rigid_body() {
+    let water = water_rig();
+    let truth = water.rigid_body().unwrap();
+    let mut air = water.clone();
+    air.fluid.density_kg_m3 = 1.204;
+    let mut rng = ChaCha8Rng::seed_from_u64(21);
+    let mut air_wing = VirtualWing::new(&virtual_wing_of(&air, Fidelity::L0)).expect("wing");
+    let air_run = rehearse(&air, &mut air_wing, &motion(2), "air.csv", &mut rng).expect("air run");
+    let mut desc = water.clone();
+    let volume = water.mass.as_ref().unwrap().volume_m3;
+    desc.mass = None;
+    desc.reference = Some(Reference {
+        recordings: vec!["air.csv".into()],
+        medium: Medium::Air,
+        volume_m3: Some(volume),
+        center_of_buoyancy_m: None,
+    });
+    desc.check().expect("valid");
+    let found = identify(&desc, &[air_run.recording]).expect("identify");
+    let got = found.inertial.expect("air gives the inertia");
+    println!(
+        "identified {got:?}\ntrue {:?}\nresidual {:?}",
+        truth.inertia, found.residual_rms
+    );
+    let m = truth.inertia.mass_kg;
+    assert!((got.mass_kg / m - 1.0).abs() < 0.01, "mass {}", got.mass_kg);
+    for k in 0..3 {
+        // The centre of mass to 0.5 mm.
+        let dc = (got.first_moment_kg_m[k] - truth.inertia.first_moment_kg_m[k]) / m;
+        assert!(dc.abs() < 5e-4, "centre of mass {k}: {dc} m off");
+    }
+    let body = found.rigid_body(&desc);
+    let mut wing = VirtualWing::new(&virtual_wing_of(&water, Fidelity::L0)).expect("wing");
+    let rehearsed =
+        rehearse(&water, &mut wing, &motion(0), "water.csv", &mut rng).expect("rehearse");
+    let processed = process_recording(&desc, Some(&body), &rehearsed.recording).expect("process");
+    let errors = relative_errors(&processed.trajectories[0], &rehearsed.truth[0]);
+    println!("with the identified body: {errors:.5?}");
+    assert!(errors.iter().all(|e| *e < 0.01), "{errors:?}");
+}
+
+/// Poses held still in the fluid identify the net weight less buoyancy (k = m − ρV,
+/// s = m·c − ρV·b) from the still samples alone, the moves between them (with their inertia)
+/// left out.
+#[test]
+fn poses_held_in_the_fluid_identify_the_net_weight() {
+    let water = water_rig();
+    let truth = water.rigid_body().unwrap();
+    let rate = water.sampling.rate_hz;
+    // The first pose is the home pose (recorded [0, 0, 0]: the plate horizontal), for the tare.
+    let poses = [
+        [0.0, 0.0, std::f64::consts::FRAC_PI_2],
+        [0.6, 0.2, 0.8],
+        [-0.7, -0.3, -0.5],
+        [0.2, 0.4, 1.4],
+        [-0.3, 0.1, -1.2],
+    ];
+    let (hold, moving) = (3000, 1500);
+    let mut states: Vec<EulerState> = Vec::new();
+    for (k, pose) in poses.iter().enumerate() {
+        if k > 0 {
+            let from = poses[k - 1];
+            let t_move = moving as f64 / rate;
+            for j in 0..moving {
+                let s = j as f64 / moving as f64;
+                let r = s * s * s * (10.0 - 15.0 * s + 6.0 * s * s);
+                let rd = 30.0 * s * s * (1.0 - s) * (1.0 - s) / t_move;
+                let rdd = 60.0 * s * (1.0 - s) * (1.0 - 2.0 * s) / (t_move * t_move);
+                states.push(EulerState {
+                    angles_rad: std::array::from_fn(|a| from[a] + r * (pose[a] - from[a])),
+                    rates_rad_s: std::array::from_fn(|a| rd * (pose[a] - from[a])),
+                    accels_rad_s2: std::array::from_fn(|a| rdd * (pose[a] - from[a])),
+                });
+            }
+        }
+        states.extend(std::iter::repeat_n(
+            EulerState {
+                angles_rad: *pose,
+                ..EulerState::default()
+            },
+            hold,
+        ));
+    }
+    let frame = SensorFrame::new(&water.sensor);
+    let all = Subtract {
+        gravity: true,
+        buoyancy: true,
+        inertia: true,
+    };
+    let (f_si, m_si) = water.sensor.to_si();
+    let offset = [5.0, -3.0, 2.0, 0.5, -0.2, 0.1];
+    let mut previous = None;
+    let recording = RawRecording {
+        source_name: "still.csv".into(),
+        time_s: Some((0..states.len()).map(|k| k as f64 / rate).collect()),
+        angles: states
+            .iter()
+            .map(|st| {
+                let a = water.angles.from_flapssm(st.angles_rad, previous);
+                previous = Some(a);
+                a
+            })
+            .collect(),
+        sensor: states
+            .iter()
+            .map(|st| {
+                let w = frame.to_sensor(&truth.loads(st, &all));
+                std::array::from_fn(|c| w[c] / if c < 3 { f_si } else { m_si } + offset[c])
+            })
+            .collect(),
+    };
+    let mut desc = water.clone();
+    desc.reference = Some(Reference {
+        recordings: vec!["still.csv".into()],
+        medium: Medium::Fluid,
+        volume_m3: None,
+        center_of_buoyancy_m: None,
+    });
+    desc.check().expect("valid");
+    let found = identify(&desc, &[recording]).expect("identify");
+    let k = truth.weight.mass_kg + truth.buoyancy.mass_kg;
+    println!("net {:?}, true k {k}", found.static_parameters);
+    // What the inertia of the moves' still ends leaves: 1e-5 of k, 1e-8 kg·m of s (0.01 mm).
+    assert!((found.static_parameters.mass_kg / k - 1.0).abs() < 1e-4);
+    for c in 0..3 {
+        let s = truth.weight.first_moment_kg_m[c] + truth.buoyancy.first_moment_kg_m[c];
+        assert!(
+            (found.static_parameters.first_moment_kg_m[c] - s).abs() < 1e-7,
+            "{c}"
+        );
+    }
+    // An air run without motion determines no inertia: refused, naming the field.
+    let mut still_air = desc.clone();
+    still_air.reference.as_mut().unwrap().medium = Medium::Air;
+    still_air.reference.as_mut().unwrap().volume_m3 = Some(1e-5);
+    let rest = RawRecording {
+        source_name: "rest.csv".into(),
+        time_s: None,
+        angles: vec![[0.0; 3]; 4000],
+        sensor: vec![[0.0; 6]; 4000],
+    };
+    let err = identify(&still_air, &[rest]).unwrap_err();
+    assert!(
+        matches!(&err, RigError::Field { field, .. } if field == "reference.recordings"),
         "{err}"
     );
 }

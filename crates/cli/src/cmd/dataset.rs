@@ -7,11 +7,14 @@ use clap::{Args, Subcommand};
 use std::time::Instant;
 
 use flapssm_jobs::files::{check_output_dir, check_outputs};
-use flapssm_jobs::own_rig::{RIG_TEMPLATE, build_dataset, load_rig, steps_file_names, write_steps};
+use flapssm_jobs::own_rig::{
+    RIG_TEMPLATE, build_dataset, load_rig, reference_files, steps_file_names, write_steps,
+};
 use flapssm_wing::cycles::{U_REF_RADIUS_M, published_u_ref};
 use flapssm_wing::dataset::Dataset;
 use flapssm_wing::dataset::ValidDataset;
 use flapssm_wing::dataset::published::import_published_mat;
+use flapssm_wing::rig::Medium;
 
 use crate::progress::Bars;
 
@@ -201,8 +204,11 @@ fn build(
     recordings: &[PathBuf],
 ) -> anyhow::Result<()> {
     let start = Instant::now();
+    let desc = load_rig(rig)?;
+    let references = reference_files(&desc, rig);
     let mut inputs: Vec<&Path> = recordings.iter().map(PathBuf::as_path).collect();
     inputs.push(rig);
+    inputs.extend(references.iter().map(PathBuf::as_path));
     check_outputs(&[out], &inputs)?;
     if let Some(dir) = steps {
         let names: Vec<String> = recordings
@@ -212,10 +218,29 @@ fn build(
         let names: Vec<&str> = names.iter().map(String::as_str).collect();
         check_output_dir(dir, &names, &inputs)?;
     }
-    let desc = load_rig(rig)?;
     let bars = Bars::new();
     let built = build_dataset(&desc, rig, recordings, n_train, &bars)?;
     drop(bars);
+    if let Some(found) = &built.identified {
+        let s = &found.static_parameters;
+        let c = s.first_moment_kg_m.map(|h| 1e3 * h / s.mass_kg);
+        println!(
+            "identified from {} reference samples ({:?}): {} {:.6} kg at ({:.2}, {:.2}, {:.2}) mm from \
+             the root; fit residual {:.2e} N, {:.2e} N·m (RMS)",
+            found.n_samples,
+            found.medium,
+            match found.medium {
+                Medium::Air => "mass",
+                Medium::Fluid => "weight less buoyancy",
+            },
+            s.mass_kg,
+            c[0],
+            c[1],
+            c[2],
+            found.residual_rms[..3].iter().cloned().fold(0.0, f64::max),
+            found.residual_rms[3..].iter().cloned().fold(0.0, f64::max),
+        );
+    }
     if let Some(dir) = steps {
         write_steps(dir, &desc, recordings, &built.processed)?;
     }

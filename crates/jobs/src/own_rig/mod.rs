@@ -11,8 +11,8 @@ use flapssm_wing::dataset::{
     ValidDataset,
 };
 use flapssm_wing::rig::{
-    ProcessedRecording, RawRecording, RecordingReport, RigDescription, process_recording, rehearse,
-    virtual_wing_of,
+    Identified, ProcessedRecording, RawRecording, RecordingReport, RigDescription, RigError,
+    RigidBody, identify, process_recording, rehearse, virtual_wing_of,
 };
 use flapssm_wing::trajectories::{GeneratorConfig, SamplingConfig, default_n_train};
 use flapssm_wing::virtual_wing::{Fidelity, VirtualWing};
@@ -131,6 +131,43 @@ pub struct Built {
     pub reports: Vec<RecordingReport>,
     /// The processed recordings (their intermediate signals), in the order given.
     pub processed: Vec<ProcessedRecording>,
+    /// The rigid body identified from the description's reference runs, if it has any.
+    pub identified: Option<Identified>,
+}
+
+/// The reference recordings of a description, relative to the directory of its file.
+pub fn reference_files(desc: &RigDescription, rig_source: &Path) -> Vec<PathBuf> {
+    let base = rig_source.parent().unwrap_or(Path::new(""));
+    desc.reference
+        .iter()
+        .flat_map(|r| r.recordings.iter().map(|f| base.join(f)))
+        .collect()
+}
+
+/// The rigid body the processing subtracts: identified from the reference runs (read relative
+/// to the description's file) if the description has any, else its `[mass]`.
+///
+/// # Errors
+/// Reading the reference recordings; [`JobError::Rig`] if they do not determine the body.
+pub fn rigid_body(
+    desc: &RigDescription,
+    rig_source: &Path,
+) -> Result<(Option<RigidBody>, Option<Identified>)> {
+    if desc.reference.is_none() {
+        return Ok((desc.rigid_body(), None));
+    }
+    let runs = reference_files(desc, rig_source)
+        .iter()
+        .map(|p| read_recording(desc, p))
+        .collect::<Result<Vec<_>>>()?;
+    let found = identify(desc, &runs).map_err(|source| match source {
+        RigError::Recording { .. } => JobError::Recording(source),
+        _ => JobError::Rig {
+            path: rig_source.to_path_buf(),
+            source,
+        },
+    })?;
+    Ok((Some(found.rigid_body(desc)), Some(found)))
 }
 
 /// Builds a dataset from raw recordings (module [`flapssm_wing::rig::recording`]): their
@@ -154,12 +191,13 @@ pub fn build_dataset(
             expected: "at least one recording file".into(),
         });
     }
+    let (body, identified) = rigid_body(desc, rig_source)?;
     progress.start("processing recordings", files.len() as u64);
     let processed: Vec<ProcessedRecording> = files
         .par_iter()
         .map(|path| {
             let rec = read_recording(desc, path)?;
-            let out = process_recording(desc, &rec).map_err(JobError::Recording);
+            let out = process_recording(desc, body.as_ref(), &rec).map_err(JobError::Recording);
             progress.advance(1);
             out
         })
@@ -201,6 +239,7 @@ pub fn build_dataset(
         "rig": desc,
         "rig_file": rig_source.display().to_string(),
         "recordings": reports,
+        "identified": identified,
     });
     let dataset = dataset_of(
         desc,
@@ -214,6 +253,7 @@ pub fn build_dataset(
         dataset,
         reports,
         processed,
+        identified,
     })
 }
 

@@ -6,6 +6,7 @@ use serde::{Deserialize, Serialize};
 
 use super::RigError;
 use super::convention::AngleConvention;
+use super::identify::{Medium, Reference};
 use crate::dataset::{Fluid, WingGeometry};
 
 /// A rig: its wing, fluid, angles, sensor, sampling and processing.
@@ -34,6 +35,9 @@ pub struct RigDescription {
     /// Mass properties of everything the sensor carries (for gravity, buoyancy, inertia).
     #[serde(default)]
     pub mass: Option<MassProperties>,
+    /// Reference runs that the rigid-body loads are identified from, instead of `[mass]`.
+    #[serde(default)]
+    pub reference: Option<Reference>,
     /// Which rigid-body loads to subtract.
     #[serde(default)]
     pub subtract: Subtract,
@@ -210,7 +214,8 @@ pub struct MassProperties {
     pub inertia_kg_m2: [f64; 6],
 }
 
-/// Which rigid-body loads the processing subtracts (each needs [`MassProperties`]).
+/// Which rigid-body loads the processing subtracts (from `[mass]`, or identified from
+/// `[reference]` runs).
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Subtract {
@@ -257,6 +262,13 @@ impl RigDescription {
             pitch_axis_frac: w.pitch_axis_frac,
             u_ref_radius_m: w.u_ref_radius_m.unwrap_or(w.root_offset_m + w.span_m),
         }
+    }
+
+    /// The rigid body of the `[mass]` section, if any.
+    pub fn rigid_body(&self) -> Option<super::rigid_body::RigidBody> {
+        self.mass.as_ref().map(|m| {
+            super::rigid_body::RigidBody::new(m, self.fluid.density_kg_m3, self.wing.root_offset_m)
+        })
     }
 
     /// The dataset's fluid.
@@ -345,18 +357,68 @@ impl RigDescription {
         if let Some(d) = self.trajectories.duration_s {
             in_range("trajectories.duration_s", d, 1e-6, 1e6)?;
         }
-        match &self.mass {
-            Some(m) => m.check()?,
-            None if self.subtract.any() => {
+        if let Some(m) = &self.mass {
+            m.check()?;
+        }
+        match &self.reference {
+            Some(r) => self.check_reference(r)?,
+            None if self.mass.is_none() && self.subtract.any() => {
                 return Err(RigError::field(
                     "subtract",
                     format!("{:?}", self.subtract),
-                    "subtracting gravity, buoyancy or inertia needs the [mass] section",
+                    "subtracting gravity, buoyancy or inertia needs the [mass] section or \
+                     [reference] runs",
                 ));
             }
             None => {}
         }
         Ok(())
+    }
+
+    /// The reference runs against what they can identify.
+    fn check_reference(&self, r: &Reference) -> Result<(), RigError> {
+        if r.recordings.is_empty() {
+            return Err(RigError::field(
+                "reference.recordings",
+                "[]",
+                "name at least one recording",
+            ));
+        }
+        if let Some(v) = r.volume_m3 {
+            in_range("reference.volume_m3", v, 0.0, 10.0)?;
+        }
+        if let Some(v) = r
+            .center_of_buoyancy_m
+            .iter()
+            .flatten()
+            .find(|v| !(v.is_finite() && v.abs() <= 10.0))
+        {
+            return Err(RigError::field(
+                "reference.center_of_buoyancy_m",
+                v,
+                "must be finite, within 10 m",
+            ));
+        }
+        let s = &self.subtract;
+        match r.medium {
+            Medium::Air if s.buoyancy && r.volume_m3.is_none() => Err(RigError::field(
+                "reference.volume_m3",
+                "none",
+                "a run in air gives no buoyancy: give the volume to subtract it",
+            )),
+            Medium::Fluid if s.gravity != s.buoyancy => Err(RigError::field(
+                "subtract",
+                format!("{s:?}"),
+                "a run in the fluid identifies the weight and the buoyancy together: subtract \
+                 both or neither",
+            )),
+            Medium::Fluid if s.inertia && self.mass.is_none() => Err(RigError::field(
+                "subtract.inertia",
+                "true",
+                "a run in the fluid gives no inertia: give [mass] for it",
+            )),
+            _ => Ok(()),
+        }
     }
 
     /// Every column named once, none empty.

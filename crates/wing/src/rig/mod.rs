@@ -13,6 +13,7 @@
 
 pub mod convention;
 pub mod description;
+pub mod identify;
 pub mod recording;
 pub mod rehearse;
 pub mod rigid_body;
@@ -22,10 +23,12 @@ pub use description::{
     Cutting, ForceUnit, LoadFilter, MassProperties, MomentUnit, RigDescription, RigFluid,
     RigSampling, RigWing, SensorPose, Subtract, Tare,
 };
+pub use identify::{Identified, Medium, Reference, identify};
 pub use recording::{
     ProcessedRecording, ProcessingSteps, RawRecording, RecordingReport, process_recording,
 };
 pub use rehearse::{Rehearsed, rehearse, virtual_wing_of};
+pub use rigid_body::RigidBody;
 
 /// Errors of a rig description or of a recording processed with it.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

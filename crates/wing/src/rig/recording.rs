@@ -11,7 +11,9 @@
 //!    `tare.tolerance_deg`); the sensor's zero is the mean reading there less the modelled
 //!    weight and buoyancy at that pose (those to be subtracted; none: the mean reading);
 //! 4. each sample: reading − zero, to SI, to wing axes about the wing root
-//!    ([`super::rigid_body::SensorFrame`]), less the rigid-body loads `subtract` names;
+//!    ([`super::rigid_body::SensorFrame`]), less the rigid-body loads `subtract` names (of the
+//!    `[mass]` section, [`RigDescription::rigid_body`], or identified from reference runs,
+//!    [`super::identify`]);
 //! 5. the zero-phase low-pass `filter.cutoff_hz` ([`crate::sensor::filtfilt`]);
 //! 6. after the rest and `trajectories.skip_s` (and at least the differentiator's half window
 //!    from either end of the recording), cut into trajectories and resampled to
@@ -88,12 +90,14 @@ pub struct ProcessedRecording {
     pub steps: ProcessingSteps,
 }
 
-/// Processes one raw recording with a (checked) rig description (module docs).
+/// Processes one raw recording with a (checked) rig description (module docs), subtracting the
+/// rigid-body loads of `body` that `desc.subtract` names (none without a body).
 ///
 /// # Errors
 /// [`RigError::Recording`] naming the recording and the row, column or field at fault.
 pub fn process_recording(
     desc: &RigDescription,
+    body: Option<&RigidBody>,
     rec: &RawRecording,
 ) -> Result<ProcessedRecording, RigError> {
     let fail = |reason: String| RigError::recording(&rec.source_name, reason);
@@ -117,14 +121,10 @@ pub fn process_recording(
         .map_err(|e| fail(format!("differentiator: {e}")))?;
 
     let frame = SensorFrame::new(&desc.sensor);
-    let body = desc
-        .mass
-        .as_ref()
-        .map(|m| RigidBody::new(m, desc.fluid.density_kg_m3, desc.wing.root_offset_m));
     let subtract = desc.subtract;
     let (f_si, m_si) = desc.sensor.to_si();
     let rigid = |st: &EulerState| -> Wrench {
-        match &body {
+        match body {
             Some(b) if subtract.any() => b.loads(st, &subtract),
             _ => [0.0; 6],
         }
@@ -222,7 +222,7 @@ pub fn process_recording(
 }
 
 /// Step 1: lengths, finite values, time.
-fn check_recording(desc: &RigDescription, rec: &RawRecording) -> Result<(), RigError> {
+pub(super) fn check_recording(desc: &RigDescription, rec: &RawRecording) -> Result<(), RigError> {
     let fail = |reason: String| RigError::recording(&rec.source_name, reason);
     let n = rec.angles.len();
     let angle_cols = &desc.angles.columns;
@@ -301,7 +301,7 @@ fn check_recording(desc: &RigDescription, rec: &RawRecording) -> Result<(), RigE
 
 /// The mean recorded pose over the rest and the largest distance (deg) of any angle from the
 /// home pose, checked against the tolerance.
-fn check_rest(
+pub(super) fn check_rest(
     desc: &RigDescription,
     rec: &RawRecording,
     n_rest: usize,

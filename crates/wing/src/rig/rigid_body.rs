@@ -8,8 +8,12 @@
 //!
 //! - weight: F = m g_w, M = c × F;
 //! - buoyancy: F = −ρV g_w, M = b × F;
-//! - inertia (d'Alembert): with c_O = c + P, a_c = ω̇ × c_O + ω × (ω × c_O),
+//! - inertia (d'Alembert): with a_c = ω̇ × c_O + ω × (ω × c_O), c_O = c + P,
 //!   F = −m a_c, M = c × F − (I_c ω̇ + ω × I_c ω).
+//!
+//! All three are linear in the parameters (m, m·c, ρV, ρV·b, I_P about P): [`static_regressor`]
+//! and [`inertial_regressor`] are those linear maps, used both for the loads of known mass
+//! properties and to identify them from a reference run ([`super::identify`]).
 //!
 //! The sensor at offset d from P with axes R_ws reports (F_s, M_s) about its origin; in wing
 //! axes about P: F = R_ws F_s, M = R_ws M_s + d × F.
@@ -68,69 +72,123 @@ impl SensorFrame {
     }
 }
 
-/// The rigid-body loads of a rig's carried mass.
+/// A static load F = k·g_w, M = s × g_w: the weight (k = m, s = m·c) or the buoyancy
+/// (k = −ρV, s = −ρV·b), or both at once as identified in the fluid.
+#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize)]
+pub struct StaticParameters {
+    /// k (kg).
+    pub mass_kg: f64,
+    /// s, about P (kg·m).
+    pub first_moment_kg_m: [f64; 3],
+}
+
+/// The inertial parameters about P: mass m, first moment h = m·c (kg·m) and the inertia tensor
+/// about P, [I_xx, I_yy, I_zz, I_xy, I_xz, I_yz] (kg·m²).
+#[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize)]
+pub struct InertialParameters {
+    /// m (kg).
+    pub mass_kg: f64,
+    /// h = m·c (kg·m).
+    pub first_moment_kg_m: [f64; 3],
+    /// I_P (kg·m²).
+    pub inertia_p_kg_m2: [f64; 6],
+}
+
+impl InertialParameters {
+    /// The parameters as the regressor's column order [m, h, I_P].
+    pub fn as_vector(&self) -> [f64; 10] {
+        let h = self.first_moment_kg_m;
+        let i = self.inertia_p_kg_m2;
+        [
+            self.mass_kg,
+            h[0],
+            h[1],
+            h[2],
+            i[0],
+            i[1],
+            i[2],
+            i[3],
+            i[4],
+            i[5],
+        ]
+    }
+}
+
+/// The rigid-body loads of what a rig's sensor carries, linear in its parameters.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RigidBody {
-    mass: MassProperties,
-    density_kg_m3: f64,
-    root_offset_m: f64,
+    /// The weight.
+    pub weight: StaticParameters,
+    /// The buoyancy.
+    pub buoyancy: StaticParameters,
+    /// The inertia.
+    pub inertia: InertialParameters,
+    /// r₀: P is (0, 0, r₀) from the wing frame's fixed origin.
+    pub root_offset_m: f64,
 }
 
 impl RigidBody {
     /// The body of `mass` in a fluid of `density_kg_m3`, on a wing whose root is
-    /// `root_offset_m` from the stroke axis.
+    /// `root_offset_m` from the stroke axis: I_P = I_c + m(|c|²E − c cᵀ).
     pub fn new(mass: &MassProperties, density_kg_m3: f64, root_offset_m: f64) -> Self {
+        let m = mass.mass_kg;
+        let c = mass.center_of_mass_m;
+        let b = mass.center_of_buoyancy_m.unwrap_or(c);
+        let displaced = density_kg_m3 * mass.volume_m3;
+        let [ixx, iyy, izz, ixy, ixz, iyz] = mass.inertia_kg_m2;
         Self {
-            mass: mass.clone(),
-            density_kg_m3,
+            weight: StaticParameters {
+                mass_kg: m,
+                first_moment_kg_m: c.map(|x| m * x),
+            },
+            buoyancy: StaticParameters {
+                mass_kg: -displaced,
+                first_moment_kg_m: b.map(|x| -displaced * x),
+            },
+            inertia: InertialParameters {
+                mass_kg: m,
+                first_moment_kg_m: c.map(|x| m * x),
+                inertia_p_kg_m2: [
+                    ixx + m * (c[1] * c[1] + c[2] * c[2]),
+                    iyy + m * (c[0] * c[0] + c[2] * c[2]),
+                    izz + m * (c[0] * c[0] + c[1] * c[1]),
+                    ixy - m * c[0] * c[1],
+                    ixz - m * c[0] * c[2],
+                    iyz - m * c[1] * c[2],
+                ],
+            },
             root_offset_m,
         }
     }
 
     /// Weight and buoyancy at the orientation `angles_rad` [φ, ψ, α], each as `which` asks.
     pub fn static_loads(&self, angles_rad: &[f64; 3], which: &Subtract) -> Wrench {
-        let r = rotation_global_from_wing(angles_rad);
-        // g_w = R_0wᵀ (0, −g, 0): the second row of R_0w.
-        let g_w = [
-            -GRAVITY_M_S2 * r[1][0],
-            -GRAVITY_M_S2 * r[1][1],
-            -GRAVITY_M_S2 * r[1][2],
-        ];
+        let y = static_regressor(gravity_in_wing(angles_rad));
         let mut out = [0.0; 6];
-        let m = &self.mass;
-        if which.gravity {
-            accumulate(&mut out, g_w.map(|g| m.mass_kg * g), m.center_of_mass_m);
-        }
-        if which.buoyancy {
-            let b = m.center_of_buoyancy_m.unwrap_or(m.center_of_mass_m);
-            let lift = g_w.map(|g| -self.density_kg_m3 * m.volume_m3 * g);
-            accumulate(&mut out, lift, b);
+        for (on, p) in [
+            (which.gravity, &self.weight),
+            (which.buoyancy, &self.buoyancy),
+        ] {
+            if on {
+                let theta = [
+                    p.mass_kg,
+                    p.first_moment_kg_m[0],
+                    p.first_moment_kg_m[1],
+                    p.first_moment_kg_m[2],
+                ];
+                add_product(&mut out, &y, &theta);
+            }
         }
         out
     }
 
-    /// The d'Alembert loads −(m a_c; c × m a_c + I_c ω̇ + ω × I_c ω) of the body in the motion
-    /// `state`.
+    /// The d'Alembert loads −(m a_c; I_P ω̇ + ω × I_P ω + h × a_P) of the body in the motion
+    /// `state` ([`inertial_regressor`]).
     pub fn inertial_loads(&self, state: &EulerState) -> Wrench {
-        let kin = WingKinematics::from_euler(state);
-        let (om, omd) = (kin.omega_rad_s, kin.omega_dot_rad_s2);
-        let m = &self.mass;
-        let c = m.center_of_mass_m;
-        let c_o = [c[0], c[1], c[2] + self.root_offset_m];
-        let acc = add(cross(omd, c_o), cross(om, cross(om, c_o)));
-        let f = acc.map(|a| -m.mass_kg * a);
-        let [ixx, iyy, izz, ixy, ixz, iyz] = m.inertia_kg_m2;
-        let inertia = [[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]];
-        let gyro = add(mv(&inertia, omd), cross(om, mv(&inertia, om)));
-        let mc = cross(c, f);
-        [
-            f[0],
-            f[1],
-            f[2],
-            mc[0] - gyro[0],
-            mc[1] - gyro[1],
-            mc[2] - gyro[2],
-        ]
+        let y = inertial_regressor(state, self.root_offset_m);
+        let mut out = [0.0; 6];
+        add_product(&mut out, &y, &self.inertia.as_vector());
+        out
     }
 
     /// The loads `which` names in the motion `state`.
@@ -144,12 +202,70 @@ impl RigidBody {
     }
 }
 
-/// Adds the force `f` acting at `at` (from P) to the wrench.
-fn accumulate(out: &mut Wrench, f: [f64; 3], at: [f64; 3]) {
-    let m = cross(at, f);
-    for k in 0..3 {
-        out[k] += f[k];
-        out[k + 3] += m[k];
+/// g_w = R_0wᵀ (0, −g, 0), the gravity in wing axes (m/s²): minus g times the second row of R_0w.
+pub fn gravity_in_wing(angles_rad: &[f64; 3]) -> [f64; 3] {
+    let r = rotation_global_from_wing(angles_rad);
+    [
+        -GRAVITY_M_S2 * r[1][0],
+        -GRAVITY_M_S2 * r[1][1],
+        -GRAVITY_M_S2 * r[1][2],
+    ]
+}
+
+/// Y_s(g) with F = k g, M = s × g equal to Y_s·[k, s_x, s_y, s_z].
+pub fn static_regressor(g: [f64; 3]) -> [[f64; 4]; 6] {
+    let mut y = [[0.0; 4]; 6];
+    for i in 0..3 {
+        y[i][0] = g[i];
+    }
+    // s × g = −[g]ₓ s.
+    y[3][2] = g[2];
+    y[3][3] = -g[1];
+    y[4][1] = -g[2];
+    y[4][3] = g[0];
+    y[5][1] = g[1];
+    y[5][2] = -g[0];
+    y
+}
+
+/// Y_i with the d'Alembert wrench of a body in the motion `state` equal to Y_i·[m, h, I_P]:
+/// a_P = ω̇ × p + ω × (ω × p) with p = (0, 0, r₀),
+/// F = −m a_P − ([ω̇]ₓ + [ω]ₓ²) h, M = [a_P]ₓ h − (L(ω̇) + [ω]ₓ L(ω)) I_P, where L(v) I_P = I_P v.
+pub fn inertial_regressor(state: &EulerState, root_offset_m: f64) -> [[f64; 10]; 6] {
+    let kin = WingKinematics::from_euler(state);
+    let (om, omd) = (kin.omega_rad_s, kin.omega_dot_rad_s2);
+    let p = [0.0, 0.0, root_offset_m];
+    let a_p = add(cross(omd, p), cross(om, cross(om, p)));
+    let skew = |v: [f64; 3]| [[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]];
+    let l = |v: [f64; 3]| {
+        [
+            [v[0], 0.0, 0.0, v[1], v[2], 0.0],
+            [0.0, v[1], 0.0, v[0], 0.0, v[2]],
+            [0.0, 0.0, v[2], 0.0, v[0], v[1]],
+        ]
+    };
+    let (s_omd, s_om, s_a) = (skew(omd), skew(om), skew(a_p));
+    let (l_omd, l_om) = (l(omd), l(om));
+    let mut y = [[0.0; 10]; 6];
+    for i in 0..3 {
+        y[i][0] = -a_p[i];
+        for j in 0..3 {
+            let om2: f64 = (0..3).map(|k| s_om[i][k] * s_om[k][j]).sum();
+            y[i][1 + j] = -(s_omd[i][j] + om2);
+            y[3 + i][1 + j] = s_a[i][j];
+        }
+        for j in 0..6 {
+            let gyro: f64 = (0..3).map(|k| s_om[i][k] * l_om[k][j]).sum();
+            y[3 + i][4 + j] = -(l_omd[i][j] + gyro);
+        }
+    }
+    y
+}
+
+/// out += Y·θ.
+fn add_product<const K: usize>(out: &mut Wrench, y: &[[f64; K]; 6], theta: &[f64; K]) {
+    for (o, row) in out.iter_mut().zip(y) {
+        *o += row.iter().zip(theta).map(|(a, b)| a * b).sum::<f64>();
     }
 }
 
