@@ -421,3 +421,103 @@ fn lerp_state(a: &EulerState, b: &EulerState, w: f64) -> EulerState {
         accels_rad_s2: l(&a.accels_rad_s2, &b.accels_rad_s2),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::rig::convention::{AngleConvention, AngleUnit};
+    use crate::rig::description::{
+        ForceUnit, MomentUnit, RigFluid, RigSampling, RigWing, SensorPose,
+    };
+
+    fn desc() -> RigDescription {
+        RigDescription {
+            name: String::new(),
+            wing: RigWing {
+                span_m: 0.1,
+                chord_m: 0.03,
+                root_offset_m: 0.02,
+                pitch_axis_frac: 0.25,
+                u_ref_radius_m: None,
+            },
+            fluid: RigFluid {
+                density_kg_m3: 1000.0,
+                kinematic_viscosity_m2_s: 1e-6,
+            },
+            angles: AngleConvention::flapssm(["a".into(), "b".into(), "c".into()], AngleUnit::Rad),
+            sensor: SensorPose {
+                columns: ["f1", "f2", "f3", "m1", "m2", "m3"].map(String::from),
+                force_unit: ForceUnit::N,
+                moment_unit: MomentUnit::NMm,
+                offset_m: [0.0; 3],
+                rotation_deg: [0.0; 3],
+                noise_sd: [0.0; 6],
+                bias_sd: [0.0; 6],
+            },
+            sampling: RigSampling {
+                rate_hz: 100.0,
+                time_column: Some("t".into()),
+                dataset_rate_hz: 25.0,
+            },
+            filter: Default::default(),
+            tare: Default::default(),
+            mass: None,
+            reference: None,
+            subtract: Default::default(),
+            trajectories: Default::default(),
+        }
+    }
+
+    fn recording(n: usize) -> RawRecording {
+        RawRecording {
+            source_name: "r.csv".into(),
+            time_s: Some((0..n).map(|k| k as f64 * 0.01).collect()),
+            angles: (0..n)
+                .map(|k| [(k as f64 * 0.05).sin(), 0.0, 0.3])
+                .collect(),
+            sensor: vec![[0.0; 6]; n],
+        }
+    }
+
+    fn reason(r: Result<ProcessedRecording, RigError>) -> String {
+        match r {
+            Err(RigError::Recording {
+                source_name,
+                reason,
+            }) => {
+                assert_eq!(source_name, "r.csv");
+                reason
+            }
+            other => panic!("expected a recording error, got {other:?}"),
+        }
+    }
+
+    /// Lengths, finite values and time stamps, each refused naming the column or row; arrays
+    /// from Python reach these checks without a table reader's.
+    #[test]
+    fn inconsistent_recordings_are_refused_naming_what() {
+        let d = desc();
+        let mut r = recording(400);
+        r.sensor.pop();
+        assert!(reason(process_recording(&d, None, &r)).contains("sensor columns have 399 rows"));
+        let mut r = recording(400);
+        r.angles[7][1] = f64::NAN;
+        assert!(
+            reason(process_recording(&d, None, &r)).contains("data row 8 of column 'b' is NaN")
+        );
+        let mut r = recording(400);
+        r.sensor[9][4] = f64::INFINITY;
+        assert!(reason(process_recording(&d, None, &r)).contains("column 'm2' is inf"));
+        let mut r = recording(400);
+        r.time_s.as_mut().unwrap().truncate(300);
+        assert!(reason(process_recording(&d, None, &r)).contains("time column 't' has 300 rows"));
+        let mut r = recording(400);
+        r.time_s.as_mut().unwrap()[200] += 0.009;
+        assert!(reason(process_recording(&d, None, &r)).contains("steps by"));
+        let r = recording(20);
+        assert!(
+            reason(process_recording(&d, None, &r))
+                .contains("fewer than the differentiator's window")
+        );
+    }
+}
