@@ -7,7 +7,7 @@ use flapssm_wing::rig::rigid_body::SensorFrame;
 use flapssm_wing::rig::{
     AngleConvention, AngleUnit, Cutting, EulerAngle, ForceUnit, LoadFilter, MassProperties, Medium,
     MomentUnit, RawRecording, Reference, RigDescription, RigError, RigFluid, RigSampling, RigWing,
-    RigidBody, SensorPose, Subtract, Tare, identify, process_recording, rehearse, virtual_wing_of,
+    SensorPose, Subtract, Tare, identify, process_recording, rehearse, virtual_wing_of,
 };
 use flapssm_wing::trajectories::{GeneratorConfig, SamplingConfig};
 use flapssm_wing::virtual_wing::{Fidelity, VirtualWing};

@@ -176,14 +176,12 @@ pub fn identify(
         } else {
             ([0.0; 6], [0.0; 3])
         };
-        for j in edge..n - edge {
-            let st = &states[j];
+        for (st, reading) in states.iter().zip(&rec.sensor).take(n - edge).skip(edge) {
             if medium == Medium::Fluid && st.rates_rad_s.iter().any(|r| r.abs() > STILL_RAD_S) {
                 continue;
             }
-            let si: [f64; 6] = std::array::from_fn(|c| {
-                (rec.sensor[j][c] - zero[c]) * if c < 3 { f_si } else { m_si }
-            });
+            let si: [f64; 6] =
+                std::array::from_fn(|c| (reading[c] - zero[c]) * if c < 3 { f_si } else { m_si });
             let target = frame.to_wing(&si);
             let g = gravity_in_wing(&st.angles_rad);
             let ys = static_regressor(std::array::from_fn(|i| g[i] - home[i]));
@@ -215,7 +213,7 @@ pub fn identify(
     // Each parameter must be excited: its column's energy against the largest.
     let diag: Vec<f64> = (0..k).map(|a| normal[(a, a)]).collect();
     let top = diag.iter().cloned().fold(0.0, f64::max);
-    if let Some(a) = diag.iter().position(|d| !(*d > 1e-12 * top)) {
+    if let Some(a) = diag.iter().position(|d| d.is_nan() || *d <= 1e-12 * top) {
         return Err(RigError::field(
             "reference.recordings",
             format!("parameter {a}"),
