@@ -25,9 +25,10 @@ fn water_rig() -> RigDescription {
         name: "water rig".into(),
         wing: RigWing {
             span_m: span,
-            chord_m: chord,
+            chord_m: Some(chord),
             root_offset_m: 0.03,
-            pitch_axis_frac: 0.25,
+            pitch_axis_frac: Some(0.25),
+            outline: None,
             u_ref_radius_m: None,
         },
         fluid: RigFluid {

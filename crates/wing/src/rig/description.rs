@@ -46,18 +46,28 @@ pub struct RigDescription {
     pub trajectories: Cutting,
 }
 
-/// A rectangular flat wing (the planform the dataset's coefficients use).
+/// A flat wing: a rectangle (`chord_m`, `pitch_axis_frac`) or an `outline`. The coefficients use
+/// its area S and mean chord c̄ = S / span; an outline enters the dataset (and the virtual wing)
+/// as the rectangle of the same span, area and mean leading-edge position.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RigWing {
     /// Span of the plate (m).
     pub span_m: f64,
-    /// Chord of the plate (m): the mean chord c̄ of the moment coefficients.
-    pub chord_m: f64,
+    /// Chord of a rectangular plate (m).
+    #[serde(default)]
+    pub chord_m: Option<f64>,
     /// Distance from the stroke axis to the wing root (m).
     pub root_offset_m: f64,
-    /// Pitch axis behind the leading edge, as a fraction of the chord.
-    pub pitch_axis_frac: f64,
+    /// Pitch axis behind the leading edge, as a fraction of the rectangle's chord.
+    #[serde(default)]
+    pub pitch_axis_frac: Option<f64>,
+    /// The planform instead of a rectangle: rows [z, y_LE, y_TE] (m), z along the span from the
+    /// root (increasing, from 0 to `span_m`), y_LE and y_TE the leading and trailing edges'
+    /// chordwise positions from the pitch axis (towards the leading edge positive); linear
+    /// between rows.
+    #[serde(default)]
+    pub outline: Option<Vec<[f64; 3]>>,
     /// Radius of U_ref (m); default the tip, `root_offset_m + span_m`.
     #[serde(default)]
     pub u_ref_radius_m: Option<f64>,
@@ -252,14 +262,29 @@ pub struct Cutting {
 }
 
 impl RigDescription {
-    /// The dataset's wing geometry.
+    /// The dataset's wing geometry: the rectangle, or the outline's equivalent one (the same
+    /// span and area S = ∫(y_LE − y_TE) dz, so c̄ = S / span, and the pitch axis
+    /// ∫y_LE dz / S of the chord behind its leading edge).
     pub fn geometry(&self) -> WingGeometry {
         let w = &self.wing;
+        let (chord_m, pitch_axis_frac) = match &w.outline {
+            Some(rows) => {
+                let trapz = |f: &dyn Fn(&[f64; 3]) -> f64| -> f64 {
+                    rows.windows(2)
+                        .map(|p| 0.5 * (f(&p[0]) + f(&p[1])) * (p[1][0] - p[0][0]))
+                        .sum()
+                };
+                let area = trapz(&|r| r[1] - r[2]);
+                let le = trapz(&|r| r[1]);
+                (area / w.span_m, le / area)
+            }
+            None => (w.chord_m.unwrap_or(0.0), w.pitch_axis_frac.unwrap_or(0.0)),
+        };
         WingGeometry {
             span_m: w.span_m,
-            chord_m: w.chord_m,
+            chord_m,
             root_offset_m: w.root_offset_m,
-            pitch_axis_frac: w.pitch_axis_frac,
+            pitch_axis_frac,
             u_ref_radius_m: w.u_ref_radius_m.unwrap_or(w.root_offset_m + w.span_m),
         }
     }
@@ -287,9 +312,24 @@ impl RigDescription {
         let w = &self.wing;
         let s = &self.sampling;
         in_range("wing.span_m", w.span_m, 1e-3, 10.0)?;
-        in_range("wing.chord_m", w.chord_m, 1e-3, 10.0)?;
         in_range("wing.root_offset_m", w.root_offset_m, 0.0, 10.0)?;
-        in_range("wing.pitch_axis_frac", w.pitch_axis_frac, 0.0, 1.0)?;
+        match (&w.outline, w.chord_m, w.pitch_axis_frac) {
+            (None, Some(c), Some(f)) => {
+                in_range("wing.chord_m", c, 1e-3, 10.0)?;
+                in_range("wing.pitch_axis_frac", f, 0.0, 1.0)?;
+            }
+            (Some(rows), None, None) => check_outline(rows, w.span_m)?,
+            _ => {
+                return Err(RigError::field(
+                    "wing",
+                    "chord_m, pitch_axis_frac, outline",
+                    "give chord_m and pitch_axis_frac (a rectangle) or an outline, not both",
+                ));
+            }
+        }
+        let g = self.geometry();
+        in_range("wing.outline (mean chord)", g.chord_m, 1e-3, 10.0)?;
+        in_range("wing.outline (pitch axis)", g.pitch_axis_frac, 0.0, 1.0)?;
         if let Some(r) = w.u_ref_radius_m {
             in_range("wing.u_ref_radius_m", r, 1e-3, 20.0)?;
         }
@@ -495,6 +535,49 @@ impl MassProperties {
     }
 }
 
+/// An outline's rows: at least two, z increasing from 0 to the span, the leading edge ahead of
+/// the trailing edge.
+fn check_outline(rows: &[[f64; 3]], span_m: f64) -> Result<(), RigError> {
+    let field = "wing.outline";
+    if rows.len() < 2 {
+        return Err(RigError::field(
+            field,
+            rows.len(),
+            "needs at least two rows [z, y_LE, y_TE]",
+        ));
+    }
+    if let Some(v) = rows
+        .iter()
+        .flatten()
+        .find(|v| !(v.is_finite() && v.abs() <= 10.0))
+    {
+        return Err(RigError::field(field, v, "must be finite, within 10 m"));
+    }
+    let (first, last) = (rows[0][0], rows[rows.len() - 1][0]);
+    if first.abs() > 1e-9 * span_m || (last - span_m).abs() > 1e-9 * span_m {
+        return Err(RigError::field(
+            field,
+            format!("z from {first} to {last}"),
+            "must run from the root (z = 0) to the tip (z = span_m)",
+        ));
+    }
+    if let Some(k) = rows.windows(2).position(|p| p[1][0] <= p[0][0]) {
+        return Err(RigError::field(
+            field,
+            format!("row {}", k + 2),
+            "z must increase",
+        ));
+    }
+    if let Some(k) = rows.iter().position(|r| r[1] <= r[2]) {
+        return Err(RigError::field(
+            field,
+            format!("row {}", k + 1),
+            "the leading edge y_LE must be ahead of the trailing edge y_TE",
+        ));
+    }
+    Ok(())
+}
+
 /// `value` finite and in [lo, hi], else a field error.
 fn in_range(field: &str, value: f64, lo: f64, hi: f64) -> Result<(), RigError> {
     if value.is_finite() && value >= lo && value <= hi {
@@ -505,5 +588,81 @@ fn in_range(field: &str, value: f64, lo: f64, hi: f64) -> Result<(), RigError> {
             value,
             &format!("must be finite and within [{lo}, {hi}]"),
         ))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn wing(outline: Option<Vec<[f64; 3]>>) -> RigWing {
+        RigWing {
+            span_m: 0.1,
+            chord_m: None,
+            root_offset_m: 0.02,
+            pitch_axis_frac: None,
+            outline,
+            u_ref_radius_m: None,
+        }
+    }
+
+    fn geometry_of(w: RigWing) -> WingGeometry {
+        with_wing(w).geometry()
+    }
+
+    fn with_wing(w: RigWing) -> RigDescription {
+        let mut d: RigDescription = serde_json::from_value(serde_json::json!({
+            "wing": {"span_m": 0.1, "chord_m": 0.03, "root_offset_m": 0.02, "pitch_axis_frac": 0.25},
+            "fluid": {"density_kg_m3": 1000.0, "kinematic_viscosity_m2_s": 1e-6},
+            "angles": {"columns": ["a", "b", "c"], "unit": "rad"},
+            "sensor": {"columns": ["1", "2", "3", "4", "5", "6"], "force_unit": "N", "moment_unit": "N*mm"},
+            "sampling": {"rate_hz": 100.0, "dataset_rate_hz": 25.0}
+        }))
+        .unwrap();
+        d.wing = w;
+        d
+    }
+
+    /// A rectangle given as an outline is the rectangle; a triangle (LE straight, TE swept)
+    /// has half the area, c̄ = S / span, and its pitch axis at ∫y_LE dz / S.
+    #[test]
+    fn an_outline_gives_the_equivalent_rectangle() {
+        let rect = geometry_of(wing(Some(vec![
+            [0.0, 0.0075, -0.0225],
+            [0.1, 0.0075, -0.0225],
+        ])));
+        assert!((rect.chord_m - 0.03).abs() < 1e-15 && (rect.pitch_axis_frac - 0.25).abs() < 1e-12);
+        let tri = geometry_of(wing(Some(vec![[0.0, 0.01, -0.05], [0.1, 0.01, 0.0]])));
+        // S = ½·0.1·(0.06 + 0.01) = 0.0035 m², c̄ = 0.035 m, ∫y_LE = 0.001 → 0.001/0.0035.
+        assert!((tri.area_m2() - 0.0035).abs() < 1e-15);
+        assert!((tri.chord_m - 0.035).abs() < 1e-15);
+        assert!((tri.pitch_axis_frac - 0.001 / 0.0035).abs() < 1e-12);
+        assert!(
+            with_wing(wing(Some(vec![[0.0, 0.01, -0.05], [0.1, 0.01, 0.0]])))
+                .check()
+                .is_ok()
+        );
+    }
+
+    /// Both a chord and an outline, an outline short of the tip or with the edges crossed:
+    /// refused naming the field.
+    #[test]
+    fn bad_outlines_are_refused() {
+        let field = |w: RigWing| match with_wing(w).check() {
+            Err(RigError::Field { field, .. }) => field,
+            other => panic!("{other:?}"),
+        };
+        let mut both = wing(Some(vec![[0.0, 0.01, -0.02], [0.1, 0.01, -0.02]]));
+        both.chord_m = Some(0.03);
+        assert_eq!(field(both), "wing");
+        assert_eq!(
+            field(wing(Some(vec![[0.0, 0.01, -0.02], [0.08, 0.01, -0.02]]))),
+            "wing.outline"
+        );
+        assert_eq!(
+            field(wing(Some(vec![[0.0, 0.01, -0.02], [0.1, -0.03, -0.02]]))),
+            "wing.outline"
+        );
+        assert_eq!(field(wing(None)), "wing");
     }
 }

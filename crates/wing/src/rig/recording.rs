@@ -435,9 +435,10 @@ mod tests {
             name: String::new(),
             wing: RigWing {
                 span_m: 0.1,
-                chord_m: 0.03,
+                chord_m: Some(0.03),
                 root_offset_m: 0.02,
-                pitch_axis_frac: 0.25,
+                pitch_axis_frac: Some(0.25),
+                outline: None,
                 u_ref_radius_m: None,
             },
             fluid: RigFluid {
