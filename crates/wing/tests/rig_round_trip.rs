@@ -358,3 +358,39 @@ fn poses_held_in_the_fluid_identify_the_net_weight() {
         "{err}"
     );
 }
+
+/// One long recording cut into pieces of `trajectories.duration_s`, resampled to a rate that
+/// is not a divisor of the recording's (1 kHz to 30 Hz, linear interpolation): every piece
+/// comes back as the wing's loads.
+#[test]
+fn a_long_recording_is_cut_and_resampled() {
+    let mut desc = water_rig();
+    desc.sampling.dataset_rate_hz = 30.0;
+    desc.trajectories.duration_s = Some(12.0);
+    desc.check().expect("valid");
+    let generator = GeneratorConfig {
+        frequency_hz: [0.25, 0.3],
+        ..GeneratorConfig::default()
+    };
+    let family = generator.family_sequence()[3];
+    let motion = generator
+        .generate_one(3, family)
+        .expect("feasible")
+        .sample_raw(&SamplingConfig {
+            raw_rate_hz: 1000.0,
+            decimation: 1,
+            n_samples: 40_000,
+        });
+    let mut wing = VirtualWing::new(&virtual_wing_of(&desc, Fidelity::L0)).expect("wing");
+    let mut rng = ChaCha8Rng::seed_from_u64(5);
+    let rehearsed = rehearse(&desc, &mut wing, &motion, "long.csv", &mut rng).expect("rehearse");
+    let processed = process_recording(&desc, desc.rigid_body().as_ref(), &rehearsed.recording)
+        .expect("process");
+    assert_eq!(processed.trajectories.len(), 3);
+    assert_eq!(rehearsed.truth.len(), 3);
+    for (got, truth) in processed.trajectories.iter().zip(&rehearsed.truth) {
+        assert_eq!(got.inputs.len(), 360);
+        let errors = relative_errors(got, truth);
+        assert!(errors.iter().all(|e| *e < 0.01), "{errors:?}");
+    }
+}
