@@ -64,7 +64,7 @@ pub struct SimulateArgs {
     /// would make of generated motions into --recordings, and to --out the virtual wing's own
     /// loads on them, the answer that `flapssm dataset build` should recover.
     #[arg(long, value_name = "FILE", requires = "recordings",
-          conflicts_with_all = ["wing_config", "noise_free", "flat", "wake", "inflow"])]
+          conflicts_with_all = ["source", "wing_config", "noise_free", "flat", "wake", "inflow"])]
     rig: Option<PathBuf>,
     /// With --rig: the directory of the raw recordings (recording_000.csv, …).
     #[arg(long, value_name = "DIR", requires = "rig")]
