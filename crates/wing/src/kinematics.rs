@@ -232,6 +232,11 @@ pub fn transpose(a: &Mat3) -> Mat3 {
     t
 }
 
+/// m·v.
+pub fn mat_vec(m: &Mat3, v: [f64; 3]) -> [f64; 3] {
+    std::array::from_fn(|i| m[i][0] * v[0] + m[i][1] * v[1] + m[i][2] * v[2])
+}
+
 /// Skew-symmetric cross-product matrix `[w]×`, with `[w]× u = w × u`.
 pub fn skew(w: [f64; 3]) -> Mat3 {
     [[0.0, -w[2], w[1]], [w[2], 0.0, -w[0]], [-w[1], w[0], 0.0]]

@@ -300,7 +300,7 @@ fn poses_held_in_the_fluid_identify_the_net_weight() {
         buoyancy: true,
         inertia: true,
     };
-    let (f_si, m_si) = water.sensor.to_si();
+    let si = water.sensor.si_per_unit();
     let offset = [5.0, -3.0, 2.0, 0.5, -0.2, 0.1];
     let mut previous = None;
     let recording = RawRecording {
@@ -318,7 +318,7 @@ fn poses_held_in_the_fluid_identify_the_net_weight() {
             .iter()
             .map(|st| {
                 let w = frame.to_sensor(&truth.loads(st, &all));
-                std::array::from_fn(|c| w[c] / if c < 3 { f_si } else { m_si } + offset[c])
+                std::array::from_fn(|c| w[c] / si[c] + offset[c])
             })
             .collect(),
     };

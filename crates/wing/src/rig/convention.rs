@@ -27,7 +27,8 @@ use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 
 use super::RigError;
-use crate::kinematics::{Mat3, mat_mul, rot_x, rot_y, rot_z, transpose};
+use crate::kinematics::{Mat3, mat_mul, mat_vec, rot_x, rot_y, rot_z, transpose};
+use crate::vec3::{cross, dot};
 
 /// One of the three Euler angles, named as in flapssm.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -211,12 +212,9 @@ pub fn rotation(order: &[EulerAngle; 3], angles: [f64; 3]) -> Mat3 {
 /// angle in [−π/2, π/2].
 pub fn decompose(order: &[EulerAngle; 3], r: &Mat3, previous: Option<[f64; 3]>) -> [f64; 3] {
     let [e1, e2, e3] = order.map(EulerAngle::axis);
-    let mv = |m: &Mat3, v: [f64; 3]| -> [f64; 3] {
-        std::array::from_fn(|i| m[i][0] * v[0] + m[i][1] * v[1] + m[i][2] * v[2])
-    };
     let s = dot(e1, cross(e2, e3));
-    let r_e3 = mv(r, e3);
-    let rt_e1 = mv(&transpose(r), e1);
+    let r_e3 = mat_vec(r, e3);
+    let rt_e1 = mat_vec(&transpose(r), e1);
     let b = (s * dot(e1, r_e3)).clamp(-1.0, 1.0).asin();
     let a = dot(cross(e1, e3), r_e3).atan2(dot(e3, r_e3));
     let c = (-dot(cross(e3, e1), rt_e1)).atan2(dot(e1, rt_e1));
@@ -257,14 +255,6 @@ fn unwrap(rows: &mut [[f64; 3]]) {
             *a = p + wrap(*a - p);
         }
     }
-}
-
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    crate::vec3::dot(a, b)
-}
-
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    crate::vec3::cross(a, b)
 }
 
 #[cfg(test)]

@@ -139,8 +139,9 @@ pub struct SensorPose {
 }
 
 impl SensorPose {
-    /// Newtons per force unit and newton-metres per moment unit.
-    pub fn to_si(&self) -> (f64, f64) {
+    /// SI per recorded unit of each channel: newtons per force unit (F_x, F_y, F_z), newton-metres
+    /// per moment unit (M_x, M_y, M_z).
+    pub fn si_per_unit(&self) -> [f64; 6] {
         let f = match self.force_unit {
             ForceUnit::N => 1.0,
             ForceUnit::MilliN => 1e-3,
@@ -149,7 +150,7 @@ impl SensorPose {
             MomentUnit::NM => 1.0,
             MomentUnit::NMm | MomentUnit::MilliNM => 1e-3,
         };
-        (f, m)
+        [f, f, f, m, m, m]
     }
 }
 

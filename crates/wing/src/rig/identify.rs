@@ -25,13 +25,12 @@ use serde::{Deserialize, Serialize};
 
 use super::RigError;
 use super::description::RigDescription;
-use super::recording::{RawRecording, check_recording, check_rest};
+use super::recording::{Prepared, RawRecording, prepare};
 use super::rigid_body::{
     InertialParameters, RigidBody, SensorFrame, StaticParameters, gravity_in_wing,
     inertial_regressor, static_regressor,
 };
-use crate::differentiate::{SavitzkyGolay, SavitzkyGolayConfig};
-use crate::kinematics::EulerState;
+use crate::differentiate::SavitzkyGolayConfig;
 
 /// The largest angular rate (rad/s, about 0.6°/s) of a sample taken as still in a run in the
 /// fluid.
@@ -84,10 +83,6 @@ impl Identified {
     /// buoyancy of `[reference]` (air) or by the inertia of `[mass]` (fluid).
     pub fn rigid_body(&self, desc: &RigDescription) -> RigidBody {
         let r0 = desc.wing.root_offset_m;
-        let from_mass = desc
-            .mass
-            .as_ref()
-            .map(|m| RigidBody::new(m, desc.fluid.density_kg_m3, r0));
         match self.medium {
             Medium::Air => {
                 let reference = desc.reference.as_ref();
@@ -111,7 +106,7 @@ impl Identified {
             Medium::Fluid => RigidBody {
                 weight: self.static_parameters,
                 buoyancy: StaticParameters::default(),
-                inertia: from_mass.map(|b| b.inertia).unwrap_or_default(),
+                inertia: desc.rigid_body().map(|b| b.inertia).unwrap_or_default(),
                 root_offset_m: r0,
             },
         }
@@ -123,7 +118,7 @@ impl Identified {
 ///
 /// # Errors
 /// [`RigError::Recording`] for a recording that fails the checks of
-/// [`super::process_recording`] or is too short; [`RigError::Field`] (`reference.recordings`)
+/// [`super::process_recording`] (or is too short for them); [`RigError::Field`] (`reference.recordings`)
 /// when the runs do not determine the parameters (an air run without motion).
 pub fn identify(
     desc: &RigDescription,
@@ -142,47 +137,28 @@ pub fn identify(
         Medium::Fluid => 4,
     };
     let rate = desc.sampling.rate_hz;
-    let dt = 1.0 / rate;
-    let sg = SavitzkyGolay::new(SavitzkyGolayConfig::spanning_default(dt))
-        .map_err(|e| RigError::field("sampling.rate_hz", rate, &e.to_string()))?;
-    let edge = sg.window() / 2;
+    let edge = SavitzkyGolayConfig::spanning_default(1.0 / rate).half_window;
     let frame = SensorFrame::new(&desc.sensor);
-    let (f_si, m_si) = desc.sensor.to_si();
+    let si = desc.sensor.si_per_unit();
     let mut normal = Mat::<f64>::zeros(k, k);
     let mut rhs = Mat::<f64>::zeros(k, 1);
     let mut rows: Vec<([[f64; 10]; 6], [f64; 6])> = Vec::new();
     for rec in recordings {
-        let fail = |reason: String| RigError::recording(&rec.source_name, reason);
-        check_recording(desc, rec)?;
-        let n = rec.angles.len();
-        if n <= 2 * edge + 1 {
-            return Err(fail(format!(
-                "{n} samples, fewer than the differentiator's window of {} for the reference fit",
-                sg.window()
-            )));
-        }
-        let n_rest = (desc.tare.rest_s * rate).round() as usize;
-        let angles = desc.angles.to_flapssm_series(&rec.angles);
-        let mut states = vec![EulerState::default(); n];
-        let mut column = vec![0.0; n];
-        sg.euler_states(&angles, dt, &mut states, &mut column)
-            .map_err(|e| fail(format!("differentiator: {e}")))?;
-        let (zero, home) = if n_rest > 0 {
-            let (home, _) = check_rest(desc, rec, n_rest)?;
-            let zero: [f64; 6] = std::array::from_fn(|c| {
-                rec.sensor[..n_rest].iter().map(|r| r[c]).sum::<f64>() / n_rest as f64
-            });
-            (zero, gravity_in_wing(&desc.angles.to_flapssm(home)))
-        } else {
-            ([0.0; 6], [0.0; 3])
+        let Prepared { states, rest } = prepare(desc, rec)?;
+        let n = states.len();
+        let (zero, home) = match &rest {
+            Some(r) => (
+                r.mean_reading,
+                gravity_in_wing(&desc.angles.to_flapssm(r.home_pose)),
+            ),
+            None => ([0.0; 6], [0.0; 3]),
         };
         for (st, reading) in states.iter().zip(&rec.sensor).take(n - edge).skip(edge) {
             if medium == Medium::Fluid && st.rates_rad_s.iter().any(|r| r.abs() > STILL_RAD_S) {
                 continue;
             }
-            let si: [f64; 6] =
-                std::array::from_fn(|c| (reading[c] - zero[c]) * if c < 3 { f_si } else { m_si });
-            let target = frame.to_wing(&si);
+            let zeroed: [f64; 6] = std::array::from_fn(|c| (reading[c] - zero[c]) * si[c]);
+            let target = frame.to_wing(&zeroed);
             let g = gravity_in_wing(&st.angles_rad);
             let ys = static_regressor(std::array::from_fn(|i| g[i] - home[i]));
             let mut y = [[0.0; 10]; 6];

@@ -100,29 +100,13 @@ pub fn process_recording(
     body: Option<&RigidBody>,
     rec: &RawRecording,
 ) -> Result<ProcessedRecording, RigError> {
-    let fail = |reason: String| RigError::recording(&rec.source_name, reason);
-    check_recording(desc, rec)?;
-    let n = rec.angles.len();
+    let Prepared { states, rest } = prepare(desc, rec)?;
+    let n = states.len();
     let rate = desc.sampling.rate_hz;
     let raw_dt = 1.0 / rate;
-    let angles = desc.angles.to_flapssm_series(&rec.angles);
-    let sg_cfg = SavitzkyGolayConfig::spanning_default(raw_dt);
-    let sg = SavitzkyGolay::new(sg_cfg).map_err(|e| fail(format!("differentiator: {e}")))?;
-    if n < sg.window() {
-        return Err(fail(format!(
-            "{n} samples, fewer than the differentiator's window of {} ({:.2} s)",
-            sg.window(),
-            sg.window() as f64 * raw_dt
-        )));
-    }
-    let mut states = vec![EulerState::default(); n];
-    let mut column = vec![0.0; n];
-    sg.euler_states(&angles, raw_dt, &mut states, &mut column)
-        .map_err(|e| fail(format!("differentiator: {e}")))?;
-
     let frame = SensorFrame::new(&desc.sensor);
     let subtract = desc.subtract;
-    let (f_si, m_si) = desc.sensor.to_si();
+    let si = desc.sensor.si_per_unit();
     let rigid = |st: &EulerState| -> Wrench {
         match body {
             Some(b) if subtract.any() => b.loads(st, &subtract),
@@ -131,7 +115,6 @@ pub fn process_recording(
     };
 
     // 3. The tare.
-    let n_rest = (desc.tare.rest_s * rate).round() as usize;
     let mut report = RecordingReport {
         source_name: rec.source_name.clone(),
         n_samples: n,
@@ -141,26 +124,16 @@ pub fn process_recording(
         tare_offset: [0.0; 6],
         rest_residual: None,
     };
-    if n_rest > 0 {
-        if n_rest >= n {
-            return Err(fail(format!(
-                "tare.rest_s = {} s is {n_rest} samples, but the recording has {n}",
-                desc.tare.rest_s
-            )));
-        }
-        let (home, motion) = check_rest(desc, rec, n_rest)?;
-        let mean: [f64; 6] = std::array::from_fn(|c| {
-            rec.sensor[..n_rest].iter().map(|r| r[c]).sum::<f64>() / n_rest as f64
-        });
+    let n_rest = rest.as_ref().map_or(0, |r| r.n_samples);
+    if let Some(rest) = &rest {
         let home_state = EulerState {
-            angles_rad: desc.angles.to_flapssm(home),
+            angles_rad: desc.angles.to_flapssm(rest.home_pose),
             ..EulerState::default()
         };
         let modelled = frame.to_sensor(&rigid(&home_state));
-        report.tare_offset =
-            std::array::from_fn(|c| mean[c] - modelled[c] / if c < 3 { f_si } else { m_si });
-        report.home_pose_measured = Some(home);
-        report.rest_motion_deg = Some(motion);
+        report.tare_offset = std::array::from_fn(|c| rest.mean_reading[c] - modelled[c] / si[c]);
+        report.home_pose_measured = Some(rest.home_pose);
+        report.rest_motion_deg = Some(rest.motion_deg);
     }
 
     // 4. Zero, units, frame, subtraction.
@@ -171,10 +144,8 @@ pub fn process_recording(
         processed: Vec::with_capacity(n),
     };
     for (reading, st) in rec.sensor.iter().zip(&states) {
-        let si: Wrench = std::array::from_fn(|c| {
-            (reading[c] - report.tare_offset[c]) * if c < 3 { f_si } else { m_si }
-        });
-        let tared = frame.to_wing(&si);
+        let zeroed: Wrench = std::array::from_fn(|c| (reading[c] - report.tare_offset[c]) * si[c]);
+        let tared = frame.to_wing(&zeroed);
         let sub = rigid(st);
         let aero: Wrench = std::array::from_fn(|c| tared[c] - sub[c]);
         steps.tared.push(dataset_channels(&tared));
@@ -187,6 +158,7 @@ pub fn process_recording(
         let sections = butterworth4(cutoff, rate);
         let pad = ((3.0 * rate / cutoff).ceil() as usize).max(12);
         let mut work = Vec::with_capacity(n + 2 * pad);
+        let mut column = vec![0.0; n];
         for c in 0..OUTPUT_NAMES.len() {
             column
                 .iter_mut()
@@ -221,8 +193,75 @@ pub fn process_recording(
     })
 }
 
+/// The tare's rest at the start of a recording.
+pub(super) struct Rest {
+    /// Its samples.
+    pub(super) n_samples: usize,
+    /// The mean sensor reading over it (sensor units).
+    pub(super) mean_reading: [f64; 6],
+    /// The mean pose over it, as recorded.
+    pub(super) home_pose: [f64; 3],
+    /// The largest distance of an angle from `tare.home_pose` during it (deg).
+    pub(super) motion_deg: f64,
+}
+
+/// A recording checked (step 1), its Euler states (step 2) and its rest (checked against the
+/// home pose), as both the processing and the identification ([`super::identify`]) start.
+pub(super) struct Prepared {
+    /// flapssm's angles, rates and accelerations of every sample.
+    pub(super) states: Vec<EulerState>,
+    /// The tare's rest; `None` without a tare.
+    pub(super) rest: Option<Rest>,
+}
+
+/// Steps 1 and 2 and the rest of the tare.
+pub(super) fn prepare(desc: &RigDescription, rec: &RawRecording) -> Result<Prepared, RigError> {
+    let fail = |reason: String| RigError::recording(&rec.source_name, reason);
+    check_recording(desc, rec)?;
+    let n = rec.angles.len();
+    let rate = desc.sampling.rate_hz;
+    let raw_dt = 1.0 / rate;
+    let angles = desc.angles.to_flapssm_series(&rec.angles);
+    let sg = SavitzkyGolay::new(SavitzkyGolayConfig::spanning_default(raw_dt))
+        .map_err(|e| fail(format!("differentiator: {e}")))?;
+    if n < sg.window() {
+        return Err(fail(format!(
+            "{n} samples, fewer than the differentiator's window of {} ({:.2} s)",
+            sg.window(),
+            sg.window() as f64 * raw_dt
+        )));
+    }
+    let mut states = vec![EulerState::default(); n];
+    let mut column = vec![0.0; n];
+    sg.euler_states(&angles, raw_dt, &mut states, &mut column)
+        .map_err(|e| fail(format!("differentiator: {e}")))?;
+    let n_rest = (desc.tare.rest_s * rate).round() as usize;
+    if n_rest == 0 {
+        return Ok(Prepared { states, rest: None });
+    }
+    if n_rest >= n {
+        return Err(fail(format!(
+            "tare.rest_s = {} s is {n_rest} samples, but the recording has {n}",
+            desc.tare.rest_s
+        )));
+    }
+    let (home_pose, motion_deg) = check_rest(desc, rec, n_rest)?;
+    let mean_reading = std::array::from_fn(|c| {
+        rec.sensor[..n_rest].iter().map(|r| r[c]).sum::<f64>() / n_rest as f64
+    });
+    Ok(Prepared {
+        states,
+        rest: Some(Rest {
+            n_samples: n_rest,
+            mean_reading,
+            home_pose,
+            motion_deg,
+        }),
+    })
+}
+
 /// Step 1: lengths, finite values, time.
-pub(super) fn check_recording(desc: &RigDescription, rec: &RawRecording) -> Result<(), RigError> {
+fn check_recording(desc: &RigDescription, rec: &RawRecording) -> Result<(), RigError> {
     let fail = |reason: String| RigError::recording(&rec.source_name, reason);
     let n = rec.angles.len();
     let angle_cols = &desc.angles.columns;
@@ -301,7 +340,7 @@ pub(super) fn check_recording(desc: &RigDescription, rec: &RawRecording) -> Resu
 
 /// The mean recorded pose over the rest and the largest distance (deg) of any angle from the
 /// home pose, checked against the tolerance.
-pub(super) fn check_rest(
+fn check_rest(
     desc: &RigDescription,
     rec: &RawRecording,
     n_rest: usize,

@@ -17,7 +17,7 @@ use rand_distr::{Distribution, Normal};
 use super::RigError;
 use super::description::{RigDescription, Subtract};
 use super::recording::{RawRecording, cut};
-use super::rigid_body::{RigidBody, SensorFrame, wrench_of_channels};
+use super::rigid_body::{SensorFrame, wrench_of_channels};
 use crate::dataset::Trajectory;
 use crate::kinematics::EulerState;
 use crate::mount::Mount;
@@ -82,17 +82,13 @@ pub fn rehearse(
     let mut aero = vec![[0.0; 5]; n];
     wing.aero_loads_into(&states, dt, &mut aero);
     let frame = SensorFrame::new(&desc.sensor);
-    let body = desc
-        .mass
-        .as_ref()
-        .map(|m| RigidBody::new(m, desc.fluid.density_kg_m3, desc.wing.root_offset_m));
+    let body = desc.rigid_body();
     let physics = Subtract {
         gravity: true,
         buoyancy: true,
         inertia: true,
     };
-    let (f_si, m_si) = desc.sensor.to_si();
-    let unit = |c: usize| if c < 3 { f_si } else { m_si };
+    let si = desc.sensor.si_per_unit();
     let std = Normal::new(0.0, 1.0).expect("unit normal");
     let bias: [f64; 6] = std::array::from_fn(|c| desc.sensor.bias_sd[c] * std.sample(rng));
     let mut sensor = Vec::with_capacity(n);
@@ -104,7 +100,7 @@ pub fn rehearse(
         }
         let s = frame.to_sensor(&w);
         sensor.push(std::array::from_fn(|c| {
-            s[c] / unit(c) + bias[c] + desc.sensor.noise_sd[c] * std.sample(rng)
+            s[c] / si[c] + bias[c] + desc.sensor.noise_sd[c] * std.sample(rng)
         }));
     }
     let mut previous = None;

@@ -20,10 +20,10 @@
 
 use super::description::{MassProperties, SensorPose, Subtract};
 use crate::kinematics::{
-    EulerState, Mat3, WingKinematics, mat_mul, rot_x, rot_y, rot_z, rotation_global_from_wing,
-    transpose,
+    EulerState, Mat3, WingKinematics, mat_mul, mat_vec, rot_x, rot_y, rot_z,
+    rotation_global_from_wing, skew, transpose,
 };
-use crate::vec3::{add, cross};
+use crate::vec3::{add, cross, sub};
 use crate::virtual_wing::GRAVITY_M_S2;
 
 /// A wrench [F (N); M (N·m)].
@@ -50,9 +50,9 @@ impl SensorFrame {
 
     /// A wrench reported by the sensor (its axes, about its origin) in wing axes about P.
     pub fn to_wing(&self, w: &Wrench) -> Wrench {
-        let f = mv(&self.wing_from_sensor, [w[0], w[1], w[2]]);
+        let f = mat_vec(&self.wing_from_sensor, [w[0], w[1], w[2]]);
         let m = add(
-            mv(&self.wing_from_sensor, [w[3], w[4], w[5]]),
+            mat_vec(&self.wing_from_sensor, [w[3], w[4], w[5]]),
             cross(self.offset_m, f),
         );
         [f[0], f[1], f[2], m[0], m[1], m[2]]
@@ -62,12 +62,9 @@ impl SensorFrame {
     pub fn to_sensor(&self, w: &Wrench) -> Wrench {
         let rt = transpose(&self.wing_from_sensor);
         let f = [w[0], w[1], w[2]];
-        let about_sensor = {
-            let d_f = cross(self.offset_m, f);
-            [w[3] - d_f[0], w[4] - d_f[1], w[5] - d_f[2]]
-        };
-        let fs = mv(&rt, f);
-        let ms = mv(&rt, about_sensor);
+        let about_sensor = sub([w[3], w[4], w[5]], cross(self.offset_m, f));
+        let fs = mat_vec(&rt, f);
+        let ms = mat_vec(&rt, about_sensor);
         [fs[0], fs[1], fs[2], ms[0], ms[1], ms[2]]
     }
 }
@@ -236,7 +233,6 @@ pub fn inertial_regressor(state: &EulerState, root_offset_m: f64) -> [[f64; 10];
     let (om, omd) = (kin.omega_rad_s, kin.omega_dot_rad_s2);
     let p = [0.0, 0.0, root_offset_m];
     let a_p = add(cross(omd, p), cross(om, cross(om, p)));
-    let skew = |v: [f64; 3]| [[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]];
     let l = |v: [f64; 3]| {
         [
             [v[0], 0.0, 0.0, v[1], v[2], 0.0],
@@ -267,10 +263,6 @@ fn add_product<const K: usize>(out: &mut Wrench, y: &[[f64; K]; 6], theta: &[f64
     for (o, row) in out.iter_mut().zip(y) {
         *o += row.iter().zip(theta).map(|(a, b)| a * b).sum::<f64>();
     }
-}
-
-fn mv(m: &Mat3, v: [f64; 3]) -> [f64; 3] {
-    std::array::from_fn(|i| m[i][0] * v[0] + m[i][1] * v[1] + m[i][2] * v[2])
 }
 
 /// The dataset's five channels [F_x, F_y (N), M_x, M_y, M_z (N·mm)] of a wrench.
