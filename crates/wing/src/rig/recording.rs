@@ -554,6 +554,13 @@ mod tests {
         let mut r = recording(400);
         r.time_s.as_mut().unwrap()[200] += 0.009;
         assert!(reason(process_recording(&d, None, &r)).contains("steps by"));
+        let mut long_rest = desc();
+        long_rest.tare.rest_s = 5.0;
+        let r = recording(400);
+        assert!(
+            reason(process_recording(&long_rest, None, &r))
+                .contains("tare.rest_s = 5 s is 500 samples")
+        );
         let r = recording(20);
         assert!(
             reason(process_recording(&d, None, &r))
