@@ -48,6 +48,8 @@ enum Command {
     Rig(cmd::rig::RigArgs),
     /// Evaluate a PR-SSM and an LRQSM on a dataset: metrics, authority, figures, report.
     Evaluate(cmd::evaluate::EvaluateArgs),
+    /// The history curve: a GP baseline's test error against the input history it is given.
+    History(cmd::history::HistoryArgs),
     /// PR-SSM sweeps: `run` one configuration (D_x or training-set size), `merge` results.
     Sweep {
         #[command(subcommand)]
@@ -96,6 +98,7 @@ fn run(command: Command) -> anyhow::Result<()> {
         Command::Qs { command } => cmd::qs::run(command),
         Command::Rig(args) => cmd::rig::run(args),
         Command::Evaluate(args) => cmd::evaluate::run(args),
+        Command::History(args) => cmd::history::run(args),
         Command::Sweep { command } => cmd::sweep::run(command),
         Command::Demo(args) => cmd::demo::run(args),
         Command::Sysid(args) => cmd::sysid::run(args),

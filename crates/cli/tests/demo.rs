@@ -129,15 +129,25 @@ fn tiny_demo_evaluate_and_sweep() {
         dir.join("lrqsm.json").to_str().unwrap(),
         "--baseline",
         "arx",
+        "--baseline",
+        "gp-static",
+        "--baseline",
+        "gp-history",
         "--out",
         ev.to_str().unwrap(),
         "--seed",
         "5",
     ]);
     let m2 = json(&ev.join("metrics.json"));
-    // The demo fitted every registered baseline (the ARX model); evaluate was asked for it.
-    assert_eq!(m["models"][2]["key"], "arx");
+    // The demo fitted every registered baseline (ARX, GP-static, GP-history); evaluate was
+    // asked for them, and refits them to the same numbers.
+    let keys: Vec<&str> = m["models"].as_array().unwrap()[2..]
+        .iter()
+        .map(|k| k["key"].as_str().unwrap())
+        .collect();
+    assert_eq!(keys, ["arx", "gp-static", "gp-history"]);
     assert_eq!(m2["models"], m["models"]);
+    assert_eq!(m2["comparisons"], m["comparisons"]);
     let o = flapssm(&[
         "evaluate",
         "--dataset",

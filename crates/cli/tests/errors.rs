@@ -121,6 +121,22 @@ fn bad_inputs_are_refused_naming_the_file_and_writing_nothing() {
             vec!["missing.npz"],
         ),
         (
+            vec!["history", "--dataset", &p("missing.npz"), "--out", "OUT"],
+            vec!["missing.npz"],
+        ),
+        (
+            vec![
+                "history",
+                "--dataset",
+                &p("data.npz"),
+                "--out",
+                "OUT",
+                "--cycles",
+                "0.25,0.5",
+            ],
+            vec!["history_cycles", "starting at 0"],
+        ),
+        (
             vec!["train", &p("data.npz"), "--out", "OUT", "--resume"],
             vec!["OUT_STEM.ckpt.json"],
         ),

@@ -33,8 +33,8 @@ use crate::curve::CurveRecorder;
 use crate::error::{JobError, Result};
 use crate::evaluate::paper::ComparisonRow;
 use crate::evaluate::{
-    AuthorityFinding, EvalOptions, EvaluationReport, METRICS_VERSION, ReportContext, evaluate,
-    versions,
+    AuthorityFinding, EvalOptions, EvaluationReport, METRICS_VERSION, PairedComparison,
+    ReportContext, evaluate, versions,
 };
 use crate::files::{load_json, save_json};
 use crate::models::lrqsm::LrqsmLoadModel;
@@ -281,6 +281,11 @@ pub struct DemoSummary {
     pub lrqsm_cycle_average_ci: Vec<Interval>,
     /// Further baselines evaluated beside the PR-SSM and the LRQSM ([`DemoConfig::baselines`]).
     pub baselines: Vec<BaselineSummary>,
+    /// The PR-SSM against the LRQSM and each baseline: per output the test RMSE difference
+    /// with its paired bootstrap interval, "significant" only where it excludes 0
+    /// ([`EvaluationReport::comparisons`]).
+    #[serde(default)]
+    pub comparisons: Vec<PairedComparison>,
     /// The Fig. 5 pairs the paper reports ([`EvaluationReport::authority_findings`]).
     pub authority: Vec<AuthorityFinding>,
     /// Median over the output states of AoA's median lag (cycles).
@@ -613,6 +618,7 @@ pub fn run_demo(
                         c.report_section(figure.exists().then_some(figure))
                     })
                     .collect(),
+                control_lags: None,
             };
             let e = &cfg.evaluation;
             let prssm = PrssmLoadModel::new(&prssm, &ds, e.particles, e.seed)?;
@@ -693,6 +699,7 @@ fn summarize(
                 overall_test_rmse: m.test_or_train().overall_rmse_standardized,
             })
             .collect(),
+        comparisons: r.comparisons.clone(),
         authority: r.authority_findings.clone(),
         aoa_median_lag_cycles: lag_of("AoA", |a| a.median_lag_cycles),
         a_x_median_lag_cycles: lag_of("a_x", |a| a.median_lag_cycles),

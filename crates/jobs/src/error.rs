@@ -47,6 +47,9 @@ pub enum JobError {
     /// The ARX baseline failed (settings, fit or prediction).
     #[error(transparent)]
     Arx(#[from] flapssm_qs::arx::ArxError),
+    /// The GP baselines' regression failed (shapes, settings, normal equations).
+    #[error("GP baseline: {0}")]
+    Regression(#[from] flapssm_prssm::regression::RegressionError),
     /// PR-SSM training or prediction failed.
     #[error("PR-SSM {what}: {source}")]
     Prssm {

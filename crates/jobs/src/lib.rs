@@ -10,8 +10,9 @@
 //! | [`train`] | PR-SSM training on a dataset's training trajectories (settings, checkpoints, resume) |
 //! | [`predict`] | open-loop predictions of every trajectory of a dataset (PR-SSM, LRQSM) |
 //! | [`stream`] | real-time PR-SSM prediction, one sample at a time (CSV in, CSV out) |
-//! | [`models`] | the load models behind one trait (PR-SSM, LRQSM, ARX) |
+//! | [`models`] | the load models behind one trait (PR-SSM, LRQSM, ARX, GP-static, GP-history) |
 //! | [`evaluate`] | both models on a dataset: metrics, authority, figures, report |
+//! | [`history`] | the history curve: a GP baseline's test error against the input history it is given |
 //! | [`rig`] | a dataset on the paper's trajectories against the published model's prediction of the rig's loads |
 //! | [`own_rig`] | a user's rig: its description, raw recordings into a dataset, the virtual wing rehearsing it |
 //! | [`sweep`] | one-configuration PR-SSM sweep runs (D_x, training-set size) and their merge |
@@ -36,6 +37,7 @@ pub mod demo;
 pub mod error;
 pub mod evaluate;
 pub mod files;
+pub mod history;
 pub mod kinematics_compare;
 pub mod models;
 pub mod own_rig;

@@ -30,6 +30,8 @@
 //!   ([`PrssmModel::save`], [`PrssmModel::load`]); [`published::import_published`]; prediction
 //!   in physical units from the model's initial-state rule ([`PrssmModel::predict_sequence`],
 //!   over [`predict::predict_standardized`]; [`Normalization::of_sequences`] for the statistics).
+//! - [`regression`]: sparse GP regression of a static map with the same kernels and k-means
+//!   inducing inputs (the static nonlinear baseline's engine).
 #![warn(missing_docs)]
 
 #[cfg(feature = "bench")]
@@ -46,6 +48,7 @@ pub mod params;
 pub mod precision;
 pub mod predict;
 pub mod published;
+pub mod regression;
 pub mod step;
 pub mod stream;
 mod tape;

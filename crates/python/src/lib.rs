@@ -32,6 +32,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
         flapssm_jobs::train::TrainingOptions::NAMES.to_vec(),
     )?;
     m.add_function(wrap_pyfunction!(evaluate::evaluate, m)?)?;
+    m.add_function(wrap_pyfunction!(evaluate::history_curve, m)?)?;
     m.add_function(wrap_pyfunction!(rig::rig_check, m)?)?;
     m.add_function(wrap_pyfunction!(own_rig::rig_template, m)?)?;
     m.add_function(wrap_pyfunction!(own_rig::load_rig_description, m)?)?;

@@ -222,9 +222,18 @@ def test_train_in_memory_writes_nothing(small, tmp_path, monkeypatch):
 def test_evaluate_returns_the_metrics(small, tmp_path):
     lrqsm = flapssm.LRQSM.fit(small, n_folds=3)
     model = _tiny(small, tmp_path / "m.json")
-    report = flapssm.evaluate(small, tmp_path / "eval", prssm=model, lrqsm=lrqsm, particles=5)
+    report = flapssm.evaluate(small, tmp_path / "eval", prssm=model, lrqsm=lrqsm, particles=5,
+                              baselines=["gp-static"])
     names = [m["model"] for m in report["models"]]
-    assert names == ["PR-SSM", "LRQSM"]
+    assert names == ["PR-SSM", "LRQSM", "GP-static"]
+    # The PR-SSM against each other model: a paired interval per output around the difference.
+    pairs = report["comparisons"]
+    assert [(c["a"], c["b"]) for c in pairs] == [("prssm", "lrqsm"), ("prssm", "gp-static")]
+    for c in pairs:
+        assert len(c["outputs"]) == 5
+        for d in c["outputs"]:
+            assert d["interval"]["lo"] <= d["difference"] <= d["interval"]["hi"]
+            assert d["significant"] == (d["interval"]["lo"] > 0 or d["interval"]["hi"] < 0)
     # The dict is metrics.json, written in the folder.
     assert json.loads((tmp_path / "eval" / "metrics.json").read_text()) == report
     # Control authority of the PR-SSM's 5 latent states over the 7 inputs.
@@ -237,6 +246,18 @@ def test_evaluate_returns_the_metrics(small, tmp_path):
     rows = report["paper_comparison"]
     assert any(r["endpoint"].startswith("C_Fx RMSE, PR-SSM") for r in rows)
     assert all(r["source"] and r["paper"] and r["flapssm"] for r in rows)
+
+
+def test_history_curve_writes_its_files_and_refuses_bad_cycles(small, tmp_path):
+    curves = flapssm.history_curve({"small": small}, tmp_path / "h", cycles=[0.0, 0.25])
+    (c,) = curves["curves"]
+    assert c["dataset"] == "small" and [r["history_cycles"] for r in c["rows"]] == [0.0, 0.25]
+    assert c["rows"][0]["versus_static"] == [] and len(c["rows"][1]["versus_static"]) == 5
+    assert json.loads((tmp_path / "h" / "history_curve.json").read_text()) == curves
+    assert (tmp_path / "h" / "history_curve.png").stat().st_size > 0
+    with pytest.raises(ValueError, match="history_cycles"):
+        flapssm.history_curve({"small": small}, tmp_path / "h2", cycles=[0.5, 0.25])
+    assert not (tmp_path / "h2").exists()
 
 
 def test_trajectories_kinematics_and_sysid_equal_the_cli(cli, tmp_path):

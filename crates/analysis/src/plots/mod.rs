@@ -26,6 +26,7 @@ use crate::error::{AnalysisError, Result};
 
 pub mod authority;
 pub mod errors;
+pub mod history;
 pub mod hovering;
 pub mod processing;
 pub mod rig;

@@ -28,7 +28,9 @@ pub struct EvaluateArgs {
     #[arg(long)]
     lrqsm: Option<PathBuf>,
     /// Also fit this baseline on the dataset's training trajectories and evaluate it
-    /// (repeatable; `arx`: least squares on 21 lags of the inputs, 2 samples apart).
+    /// (repeatable): `arx` (least squares on 21 lags of the inputs, 2 samples apart),
+    /// `gp-static` (sparse GP regression of the instantaneous inputs), `gp-history` (the same
+    /// given a history of the inputs, its length chosen on the training trajectories).
     #[arg(long, value_name = "KEY", value_parser = baseline_key)]
     baseline: Vec<String>,
     /// Output folder.
@@ -132,6 +134,45 @@ pub fn run(a: EvaluateArgs) -> anyhow::Result<()> {
             first.model,
             second.model,
             f(&r.rmse_ratio)
+        );
+    }
+    for c in &r.comparisons {
+        let name = |k: &str| r.model(k).map_or(k, |m| m.model.as_str()).to_string();
+        println!(
+            "{} − {} ({}, paired 95 % interval): {}",
+            name(&c.a),
+            name(&c.b),
+            c.split,
+            c.outputs
+                .iter()
+                .map(|d| format!(
+                    "{:+.3} [{:+.3}, {:+.3}]{}",
+                    d.difference,
+                    d.interval.lo,
+                    d.interval.hi,
+                    if d.significant { "*" } else { "" }
+                ))
+                .collect::<Vec<_>>()
+                .join("  ")
+        );
+    }
+    for c in &r.authority_controls {
+        let m = |m: &flapssm_jobs::evaluate::controls::ControlMeasure| {
+            format!(
+                "|r| {:.2} lag {:.3}{}",
+                m.median_abs_r,
+                m.median_lag_cycles,
+                if m.reproduces { " ✓" } else { "  " }
+            )
+        };
+        println!(
+            "Fig. 5 {} → outputs: trained {}; loads {}; memoryless {}; stand-in {} — {}",
+            c.input,
+            m(&c.trained),
+            m(&c.dataset_loads),
+            m(&c.memoryless_loads),
+            m(&c.stand_in),
+            c.verdict()
         );
     }
     println!(

@@ -5,6 +5,7 @@ pub mod choices;
 pub mod dataset;
 pub mod demo;
 pub mod evaluate;
+pub mod history;
 pub mod model;
 pub mod predict;
 pub mod qs;

@@ -69,6 +69,7 @@ pub(super) fn html_report(
     let accuracy_figs = accuracy_figures(&f, models);
     sections.push(accuracy_section(r, accuracy_figs));
     sections.extend(authority_section(r, f.fig5, models));
+    sections.extend(controls_section(r));
     sections.push(Section {
         heading: "Wing motions".into(),
         figures: vec![Figure {
@@ -100,6 +101,47 @@ pub(super) fn html_report(
         }),
         versions: versions(),
     }
+}
+
+/// The Fig. 5 findings on the outputs beside their controls ([`super::controls`]).
+fn controls_section(r: &EvaluationReport) -> Option<Section> {
+    if r.authority_controls.is_empty() {
+        return None;
+    }
+    let cell = |m: &super::controls::ControlMeasure| {
+        format!(
+            "|r| {:.2}, lag {:.3}{}",
+            m.median_abs_r,
+            m.median_lag_cycles,
+            if m.reproduces { " ✓" } else { "" }
+        )
+    };
+    let rows = r
+        .authority_controls
+        .iter()
+        .map(|c| {
+            vec![
+                format!("{} → outputs", c.input),
+                c.paper.clone(),
+                c.rule.clone(),
+                cell(&c.trained),
+                cell(&c.dataset_loads),
+                cell(&c.memoryless_loads),
+                cell(&c.stand_in),
+                c.verdict().into(),
+            ]
+        })
+        .collect();
+    Some(Section {
+        heading: "Fig. 5 findings against controls".into(),
+        paragraphs: vec!["The paper's cross-correlation rule on the trained model's output states x1–x5, on the dataset's loads, on the loads of a wing without fluid memory (L0, no sensor chain) on the same trajectories, and on the rig stand-in (the published model's mean prediction); medians over the five outputs, on the paper's 512 training trajectories for the loads. ✓: the column reproduces the paper's finding by the rule given. A finding the memoryless wing reproduces follows from the kinematics and cannot be evidence of fluid memory.".into()],
+        tables: vec![Table {
+            caption: "Fig. 5 findings on the outputs and their controls".into(),
+            header: strings(&["finding", "paper", "rule", "trained model x1–x5", "dataset loads", "memoryless wing loads", "rig stand-in", "verdict"]),
+            rows,
+        }],
+        ..Default::default()
+    })
 }
 
 /// The report's key figures: the dataset, the overall test RMSE of every model, the ratios of
@@ -250,6 +292,42 @@ fn accuracy_section(r: &EvaluationReport, figures: Vec<Figure>) -> Section {
     rmse_header.push("overall".into());
     rmse_header.push("median last-cycle RMSE C_Fx / C_Fy".into());
     let (test_header, test_rows) = test_trajectory_table(r);
+    let model_name = |key: &str| {
+        r.model(key)
+            .map_or_else(|| key.to_string(), |m| m.model.clone())
+    };
+    let paired_rows: Vec<Vec<String>> = r
+        .comparisons
+        .iter()
+        .map(|c| {
+            row(
+                format!("{} − {} ({})", model_name(&c.a), model_name(&c.b), c.split),
+                c.outputs
+                    .iter()
+                    .map(|d| {
+                        format!(
+                            "{:+.3} [{:+.3}, {:+.3}]{}",
+                            d.difference,
+                            d.interval.lo,
+                            d.interval.hi,
+                            if d.significant { " *" } else { "" }
+                        )
+                    })
+                    .collect(),
+            )
+        })
+        .collect();
+    let mut tables = Vec::new();
+    if !paired_rows.is_empty() {
+        tables.push(Table {
+            caption: format!(
+                "Paired differences of RMSE (σ units) with {} % bootstrap intervals over trajectories; * the interval excludes 0",
+                r.options.level
+            ),
+            header: header("models", &OUTPUT_NAMES),
+            rows: paired_rows,
+        });
+    }
     Section {
         heading: "Accuracy".into(),
         paragraphs: vec![format!(
@@ -277,7 +355,10 @@ fn accuracy_section(r: &EvaluationReport, figures: Vec<Figure>) -> Section {
                 header: test_header,
                 rows: test_rows,
             },
-        ],
+        ]
+        .into_iter()
+        .chain(tables)
+        .collect(),
         figures,
     }
 }

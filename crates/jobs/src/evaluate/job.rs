@@ -8,6 +8,7 @@ use flapssm_prssm::PrssmModel;
 use flapssm_qs::LrqsmModel;
 use flapssm_wing::dataset::ValidDataset;
 
+use super::controls::control_lags;
 use super::evaluate;
 use super::report::{EvalOptions, EvaluationReport, ReportContext};
 use crate::error::Result;
@@ -69,22 +70,27 @@ pub fn evaluate_models(
         all.push(m);
     }
     all.extend(baselines.iter().map(|m| &**m));
-    let rig_section = match models.reference {
+    let (rig_section, control_lags) = match models.reference {
         Some(path) => {
             let model = load_reference_model(path)?;
             let reference = rig_reference(&model, ds.len(), &RigSettings::default(), progress)?;
             let check = rig_check(ds, &reference, true)?;
             write_rig_check(out_dir, &check, ds, &reference, dataset_label)?;
             let figure = out_dir.join(RIG_FILES[2]);
-            Some(check.report_section(figure.exists().then_some(figure)))
+            let lags = control_lags(ds, &check, &reference, progress)?;
+            (
+                Some(check.report_section(figure.exists().then_some(figure))),
+                Some(lags),
+            )
         }
-        None => None,
+        None => (None, None),
     };
     let names: Vec<&str> = all.iter().map(|m| m.name()).collect();
     let context = ReportContext {
         intro: format!("{} evaluated on {dataset_label}.", names.join(", ")),
         config,
         extra_sections: rig_section.into_iter().collect(),
+        control_lags,
         ..ReportContext::default()
     };
     evaluate(ds, dataset_label, &all, opts, &context, out_dir, progress)

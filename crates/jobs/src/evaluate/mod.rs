@@ -16,7 +16,8 @@
 //!   period = the cycle duration.
 //!
 //! The first model is the one studied and the second its baseline: `rmse_ratio` is first /
-//! second, as the paper's PR-SSM / LRQSM.
+//! second, as the paper's PR-SSM / LRQSM. Every other model is compared with the first by a
+//! paired bootstrap over the test trajectories ([`PairedComparison`]).
 
 use std::path::Path;
 
@@ -28,6 +29,7 @@ use crate::models::{LoadModel, predict_all};
 use crate::progress::Progress;
 
 mod authority;
+pub mod controls;
 mod figures;
 mod html;
 mod job;
@@ -42,16 +44,16 @@ mod tests;
 pub use html::versions;
 pub use job::{EvaluationModels, evaluate_models};
 pub use report::{
-    AuthorityFinding, COEFFICIENT_LABELS, EVALUATION_FILES, EvalOptions, EvaluationReport,
-    INPUT_LABELS, METRICS_VERSION, ModelMetrics, PredictionTiming, ReportContext, SplitMetrics,
-    TrajectoryMetrics, TrajectoryModelMetrics,
+    AuthorityFinding, COEFFICIENT_LABELS, COMPARISON_DRAWS, EVALUATION_FILES, EvalOptions,
+    EvaluationReport, INPUT_LABELS, METRICS_VERSION, ModelMetrics, PairedComparison,
+    PredictionTiming, ReportContext, SplitMetrics, TrajectoryMetrics, TrajectoryModelMetrics,
 };
 
 use authority::authority;
 use figures::{draw_figures, example_trajectories};
 use html::html_report;
 use paper::compare;
-use scores::{Sets, check, model_metrics, prepare, trajectory_metrics};
+use scores::{Sets, check, model_metrics, paired_comparisons, prepare, trajectory_metrics};
 use tables::{trajectories_csv, write_predictions};
 
 /// Evaluates `models` on `ds` and writes into `out_dir`: `metrics.json`
@@ -106,6 +108,7 @@ pub fn evaluate(
             .collect(),
         _ => Vec::new(),
     };
+    let comparisons = paired_comparisons(models, &sets, opts)?;
     let trajectories = trajectory_metrics(ds, models, &prep, n_train, opts)?;
     let latent = models.iter().position(|m| m.n_latent() > 0);
     let authority = latent
@@ -143,6 +146,7 @@ pub fn evaluate(
         &examples,
         &mut file,
     )?;
+    let report_findings = authority.map(|a| a.findings);
     let mut report = EvaluationReport {
         version: METRICS_VERSION,
         dataset: dataset_label.to_string(),
@@ -152,7 +156,7 @@ pub fn evaluate(
         models: metrics,
         rmse_ratio,
         trajectories,
-        authority_findings: authority.map(|a| a.findings).unwrap_or_default(),
+        authority_findings: report_findings.clone().unwrap_or_default(),
         example_trajectories: examples,
         paper_comparison: Vec::new(),
         prediction_timing: models
@@ -167,6 +171,11 @@ pub fn evaluate(
                 })
             })
             .collect(),
+        comparisons,
+        authority_controls: match (&context.control_lags, &report_findings) {
+            (Some(lags), Some(findings)) => controls::authority_controls(findings, lags),
+            _ => Vec::new(),
+        },
         files: {
             let mut f = files.clone();
             f.retain(|f| figures.written(f));

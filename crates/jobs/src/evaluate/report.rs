@@ -1,6 +1,9 @@
 //! What an evaluation writes: its settings, the metrics of each model and trajectory, the
 //! authority findings and the report's added text; the file names it may write.
 
+use flapssm_analysis::bootstrap::PairedDifference;
+
+use super::controls::{AuthorityControl, ControlLags};
 use serde::{Deserialize, Serialize};
 
 use flapssm_analysis::authority::AuthorityConfig;
@@ -250,6 +253,15 @@ pub struct EvaluationReport {
     /// Prediction wall time per model (machine-dependent, unlike everything else here).
     #[serde(default)]
     pub prediction_timing: Vec<PredictionTiming>,
+    /// The first model against each other on the test trajectories (training without a test
+    /// set): per output the RMSE difference with its paired bootstrap interval.
+    #[serde(default)]
+    pub comparisons: Vec<PairedComparison>,
+    /// The Fig. 5 findings on the outputs beside their controls (the dataset's loads, a
+    /// memoryless wing's, the rig stand-in's); empty without the rig's reference or a
+    /// latent-state model.
+    #[serde(default)]
+    pub authority_controls: Vec<AuthorityControl>,
     /// Files written, relative to the output folder.
     pub files: Vec<String>,
 }
@@ -260,6 +272,25 @@ impl EvaluationReport {
         self.models.iter().find(|m| m.key == key)
     }
 }
+
+/// Model `a` against model `b`: per output `RMSE_a − RMSE_b` (σ units, pooled from
+/// `start_sample`) with its paired bootstrap interval over trajectories
+/// ([`flapssm_analysis::bootstrap`], [`COMPARISON_DRAWS`] draws at the options' level and
+/// seed); negative means `a` is more accurate, "significant" that the interval excludes 0.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PairedComparison {
+    /// Key of model `a` (the first model).
+    pub a: String,
+    /// Key of model `b`.
+    pub b: String,
+    /// Trajectories resampled (`test`, or `train` without a test set).
+    pub split: String,
+    /// One per output.
+    pub outputs: Vec<PairedDifference>,
+}
+
+/// Bootstrap draws of each [`PairedComparison`].
+pub const COMPARISON_DRAWS: usize = 2000;
 
 /// Text and settings the caller adds to the HTML report.
 #[derive(Debug, Clone, Default)]
@@ -274,6 +305,9 @@ pub struct ReportContext {
     pub config: serde_json::Value,
     /// Sections placed after the paper comparison (e.g. the rig check, [`crate::rig`]).
     pub extra_sections: Vec<flapssm_analysis::report::Section>,
+    /// The lag statistics of the Fig. 5 controls ([`super::controls`]), when the rig's
+    /// reference was given.
+    pub control_lags: Option<ControlLags>,
 }
 
 /// Where flapssm's value lies against the paper's range.

@@ -7,9 +7,13 @@ use flapssm_wing::cycles::published_window;
 use flapssm_wing::dataset::ValidDataset;
 
 use super::prepared::{ModelTables, Prepared, cycle_errors, rows, split_metrics};
-use super::report::{EvalOptions, ModelMetrics, TrajectoryMetrics, TrajectoryModelMetrics};
+use super::report::{
+    COMPARISON_DRAWS, EvalOptions, ModelMetrics, PairedComparison, TrajectoryMetrics,
+    TrajectoryModelMetrics,
+};
 use crate::error::{JobError, Result, analysis};
 use crate::models::{LoadModel, ModelPrediction};
+use flapssm_analysis::bootstrap::{TrajectoryErrors, paired_bootstrap};
 
 /// Checks the inputs once, before any prediction.
 pub(super) fn check(
@@ -193,4 +197,55 @@ pub(super) fn trajectory_metrics(
         });
     }
     Ok(trajectories)
+}
+
+/// The first model against each other one ([`PairedComparison`]) on the test trajectories, or
+/// on the training ones without a test set.
+pub(super) fn paired_comparisons(
+    models: &[&dyn LoadModel],
+    sets: &Sets<'_>,
+    opts: &EvalOptions,
+) -> Result<Vec<PairedComparison>> {
+    let (split, set) = if sets.test.is_empty() {
+        ("train", &sets.train)
+    } else {
+        ("test", &sets.test)
+    };
+    let errors = |k: usize| -> Result<TrajectoryErrors> {
+        let tables: Vec<Vec<f64>> = set
+            .iter()
+            .map(|p| {
+                p.measured_z
+                    .iter()
+                    .zip(&p.models[k].z)
+                    .skip(5 * opts.start_sample)
+                    .map(|(y, q)| y - q)
+                    .collect()
+            })
+            .collect();
+        TrajectoryErrors::of_tables(tables.iter().map(|t| &t[..]), 5)
+            .map_err(analysis(format!("{} paired errors", models[k].name())))
+    };
+    if models.len() < 2 {
+        return Ok(Vec::new());
+    }
+    let first = errors(0)?;
+    (1..models.len())
+        .map(|k| {
+            let what = format!("{} against {}", models[0].name(), models[k].name());
+            Ok(PairedComparison {
+                a: models[0].key().into(),
+                b: models[k].key().into(),
+                split: split.into(),
+                outputs: paired_bootstrap(
+                    &first,
+                    &errors(k)?,
+                    COMPARISON_DRAWS,
+                    opts.level,
+                    opts.seed,
+                )
+                .map_err(analysis(what))?,
+            })
+        })
+        .collect()
 }

@@ -11,6 +11,7 @@
 //! | PR-SSM | [`prssm`] | particle ELBO with Adam ([`crate::train`]) |
 //! | LRQSM | [`lrqsm`] | elastic net with cross-validation (`flapssm-qs`) |
 //! | ARX (a [`Baseline`]) | [`arx`] | least squares on lagged inputs |
+//! | GP-static, GP-history ([`Baseline`]s) | [`gp`] | sparse GP regression of the inputs (and a controlled history) |
 
 use flapssm_prssm::train::EpochRecord;
 use flapssm_wing::dataset::{Trajectory, ValidDataset};
@@ -20,6 +21,7 @@ use crate::error::{JobError, Result};
 use crate::progress::Progress;
 
 pub mod arx;
+pub mod gp;
 pub mod lrqsm;
 pub mod prssm;
 
@@ -105,7 +107,7 @@ impl std::fmt::Debug for Baseline {
 }
 
 /// Every registered baseline.
-pub const BASELINES: &[Baseline] = &[arx::BASELINE];
+pub const BASELINES: &[Baseline] = &[arx::BASELINE, gp::STATIC, gp::HISTORY];
 
 /// The registered baseline `key`.
 ///

@@ -44,6 +44,7 @@ __all__ = [
     "sysid",
     "train",
     "evaluate",
+    "history_curve",
     "rig_check",
     "rig_template",
     "load_rig",
@@ -331,11 +332,34 @@ def evaluate(
     seed: int = 0,
     start_sample: int = 93,
     progress: Optional[Progress] = None,
+    baselines: Sequence[str] = (),
 ) -> dict:
     """The paper's analyses (``flapssm evaluate``): RMSE per output, standardized-error 95 %
     intervals, half-stroke averages, control authority of the latent states, figures and
-    ``report.html`` in ``out``; returns ``metrics.json`` as a dict."""
-    text = _native.evaluate(dataset, os.fspath(out), prssm, lrqsm, particles, seed, start_sample, progress)
+    ``report.html`` in ``out``; returns ``metrics.json`` as a dict. ``baselines``: keys of
+    registered baselines fitted on the dataset's training trajectories (``"arx"``,
+    ``"gp-static"``, ``"gp-history"``); the first model is compared with every other one by a
+    paired bootstrap (``comparisons``)."""
+    text = _native.evaluate(dataset, os.fspath(out), prssm, lrqsm, particles, seed, start_sample, progress,
+                            list(baselines))
+    return json.loads(text)
+
+
+def history_curve(
+    datasets: "dict[str, _native.Dataset]",
+    out: PathLike,
+    cycles: Optional[Sequence[float]] = None,
+    start_sample: int = 93,
+    seed: int = 0,
+    progress: Optional[Progress] = None,
+) -> dict:
+    """The history curve (``flapssm history``): for each dataset (label → dataset), the GP
+    baseline given 0 to one stroke cycle of input history (``cycles``, increasing from 0), its
+    test RMSE per output and the paired difference against no history; writes
+    ``history_curve.{json,csv,png}`` in ``out`` and returns the JSON as a dict."""
+    text = _native.history_curve(list(datasets.items()), os.fspath(out),
+                                 None if cycles is None else [float(c) for c in cycles],
+                                 start_sample, seed, progress)
     return json.loads(text)
 
 

@@ -1,7 +1,7 @@
 """Type stubs of the Rust extension module (shapes in the docstrings of :mod:`flapssm`)."""
 
 from os import PathLike
-from typing import Any, Callable, Optional, Tuple, Union
+from typing import Any, Callable, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -120,4 +120,7 @@ def rehearse_rig(directory: _Path, rig: Optional[_Path] = None, rig_json: Option
 def rig_check(dataset: Dataset, reference: _Path, out: Optional[_Path] = None, particles: int = 30,
               seed: int = 1, lags: bool = True, progress: _Progress = None) -> str: ...
 def evaluate(dataset: Dataset, out: _Path, prssm: Optional[Prssm] = None, lrqsm: Optional[Lrqsm] = None,
-             particles: int = 30, seed: int = 0, start_sample: int = 93, progress: _Progress = None) -> str: ...
+             particles: int = 30, seed: int = 0, start_sample: int = 93, progress: _Progress = None,
+             baselines: Sequence[str] = ()) -> str: ...
+def history_curve(datasets: Sequence[Tuple[str, Dataset]], out: _Path, cycles: Optional[Sequence[float]] = None,
+                  start_sample: int = 93, seed: int = 0, progress: _Progress = None) -> str: ...
