@@ -105,6 +105,17 @@ pub struct PairedDifference {
     pub significant: bool,
 }
 
+impl std::fmt::Display for PairedDifference {
+    /// `+0.012 [−0.003, +0.027]`: the difference and its interval, signed, 3 decimals.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{:+.3} [{:+.3}, {:+.3}]",
+            self.difference, self.interval.lo, self.interval.hi
+        )
+    }
+}
+
 /// The paired bootstrap of `RMSE_A − RMSE_B` per output (module docs): `n_draws` draws from
 /// `seed`, central `level` % intervals.
 ///

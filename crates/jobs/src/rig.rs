@@ -19,7 +19,6 @@ pub use flapssm_analysis::rig::{ChannelAgreement, Couplings, SetAgreement};
 use flapssm_analysis::rig::{RigTrajectory, set_agreement};
 use flapssm_analysis::stats::Rows;
 use flapssm_prssm::{Normalization, PrssmModel};
-use flapssm_wing::cycles::published_window;
 use flapssm_wing::dataset::ValidDataset;
 use flapssm_wing::mount::Mount;
 use flapssm_wing::sensor::SensorConfig;
@@ -113,7 +112,7 @@ pub struct RigReference {
     pub var_z: Vec<Vec<f64>>,
     /// The trajectories' kinematics ([`paper_kinematics`]).
     pub kinematics: ValidDataset,
-    /// Each trajectory's stroke period (samples, [`published_window`]).
+    /// Each trajectory's stroke period (samples, [`flapssm_wing::cycles::published_window`]).
     pub period_samples: Vec<f64>,
     /// The input standardization: mean and SD over the paper's 512 training trajectories.
     pub input_mean: [f64; 7],
@@ -171,8 +170,7 @@ pub fn rig_reference(
         .iter()
         .enumerate()
         .map(|(i, t)| {
-            let stroke: Vec<f64> = t.euler_rad.iter().map(|e| e[0]).collect();
-            published_window(&stroke)
+            t.published_window()
                 .map(|w| w.duration as f64)
                 .map_err(|source| JobError::Cycle {
                     trajectory: i,

@@ -145,13 +145,7 @@ pub fn run(a: EvaluateArgs) -> anyhow::Result<()> {
             c.split,
             c.outputs
                 .iter()
-                .map(|d| format!(
-                    "{:+.3} [{:+.3}, {:+.3}]{}",
-                    d.difference,
-                    d.interval.lo,
-                    d.interval.hi,
-                    if d.significant { "*" } else { "" }
-                ))
+                .map(|d| format!("{d}{}", if d.significant { "*" } else { "" }))
                 .collect::<Vec<_>>()
                 .join("  ")
         );

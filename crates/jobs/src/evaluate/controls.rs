@@ -21,6 +21,7 @@ use flapssm_wing::dataset::ValidDataset;
 use flapssm_wing::virtual_wing::Fidelity;
 use serde::{Deserialize, Serialize};
 
+use super::paper::FIG5_CLAIMS;
 use super::report::AuthorityFinding;
 use crate::error::Result;
 use crate::progress::Progress;
@@ -111,40 +112,32 @@ impl AuthorityControl {
     }
 }
 
-/// The claims on the outputs: input, the paper's words, the rule and its test on (|r|, lag).
-type Rule = (
-    &'static str,
-    &'static str,
-    &'static str,
-    fn(f64, f64) -> bool,
-);
+/// The claims on the outputs: input, the rule and its test on (|r|, lag). The paper's words
+/// are its claim's in [`FIG5_CLAIMS`].
+type Rule = (&'static str, &'static str, fn(f64, f64) -> bool);
 
 const RULES: [Rule; 4] = [
-    (
-        "AoA",
-        "consistently around 0 delay and |r| 0.75",
-        "|lag| ≤ 0.05 cycle and |r| ≥ 0.6",
-        |r, lag| lag.abs() <= 0.05 && r >= 0.6,
-    ),
-    (
-        "a_x",
-        "strong, delay persistently around 20 % of the cycle",
-        "0.15 ≤ lag ≤ 0.25 cycle",
-        |_, lag| (0.15..=0.25).contains(&lag),
-    ),
-    (
-        "dα/dt",
-        "median |r| within [0.7, 0.8]; delays scattered",
-        "0.65 ≤ |r| ≤ 0.85",
-        |r, _| (0.65..=0.85).contains(&r),
-    ),
-    (
-        "d²α/dt²",
-        "median |r| within [0.7, 0.8]; delays scattered",
-        "0.65 ≤ |r| ≤ 0.85",
-        |r, _| (0.65..=0.85).contains(&r),
-    ),
+    ("AoA", "|lag| ≤ 0.05 cycle and |r| ≥ 0.6", |r, lag| {
+        lag.abs() <= 0.05 && r >= 0.6
+    }),
+    ("a_x", "0.15 ≤ lag ≤ 0.25 cycle", |_, lag| {
+        (0.15..=0.25).contains(&lag)
+    }),
+    ("dα/dt", "0.65 ≤ |r| ≤ 0.85", |r, _| {
+        (0.65..=0.85).contains(&r)
+    }),
+    ("d²α/dt²", "0.65 ≤ |r| ≤ 0.85", |r, _| {
+        (0.65..=0.85).contains(&r)
+    }),
 ];
+
+/// The paper's words on `input` → the outputs x1–x5.
+fn paper_text(input: &str) -> &'static str {
+    FIG5_CLAIMS
+        .iter()
+        .find(|c| c.states.len() == 5 && c.inputs.contains(&input))
+        .map_or("", |c| c.text)
+}
 
 fn med(v: Vec<f64>) -> f64 {
     median(&v).unwrap_or(f64::NAN)
@@ -158,7 +151,7 @@ pub fn authority_controls(
     let outputs: Vec<String> = (1..=5).map(|s| format!("x{s}")).collect();
     RULES
         .iter()
-        .filter_map(|&(input, paper, rule, test)| {
+        .filter_map(|&(input, rule, test)| {
             let of: Vec<&AuthorityFinding> = findings
                 .iter()
                 .filter(|f| f.input == input && outputs.contains(&f.state))
@@ -185,7 +178,7 @@ pub fn authority_controls(
             let memoryless_loads = of_pairs(&lags.memoryless, false);
             Some(AuthorityControl {
                 input: input.into(),
-                paper: paper.into(),
+                paper: paper_text(input).into(),
                 rule: rule.into(),
                 trained: measure(
                     med(of.iter().map(|f| f.median_abs_r).collect()),
@@ -261,6 +254,7 @@ mod tests {
         assert_eq!(c.len(), 2);
         let aoa = &c[0];
         assert_eq!(aoa.input, "AoA");
+        assert_eq!(aoa.paper, "consistently around 0 delay and |r| 0.75");
         assert!(aoa.trained.reproduces && aoa.dataset_loads.reproduces && aoa.stand_in.reproduces);
         assert!(!aoa.memoryless_loads.reproduces && !aoa.also_without_memory);
         assert_eq!(aoa.verdict(), "not without memory");

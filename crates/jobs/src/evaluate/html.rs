@@ -304,15 +304,7 @@ fn accuracy_section(r: &EvaluationReport, figures: Vec<Figure>) -> Section {
                 format!("{} − {} ({})", model_name(&c.a), model_name(&c.b), c.split),
                 c.outputs
                     .iter()
-                    .map(|d| {
-                        format!(
-                            "{:+.3} [{:+.3}, {:+.3}]{}",
-                            d.difference,
-                            d.interval.lo,
-                            d.interval.hi,
-                            if d.significant { " *" } else { "" }
-                        )
-                    })
+                    .map(|d| format!("{d}{}", if d.significant { " *" } else { "" }))
                     .collect(),
             )
         })

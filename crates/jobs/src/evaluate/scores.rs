@@ -3,7 +3,6 @@
 
 use flapssm_analysis::cycles_avg::CycleWindow;
 use flapssm_analysis::metrics::{CoefficientScales, PooledErrors, coefficients_of, window_rmse};
-use flapssm_wing::cycles::published_window;
 use flapssm_wing::dataset::ValidDataset;
 
 use super::prepared::{ModelTables, Prepared, cycle_errors, rows, split_metrics};
@@ -59,8 +58,7 @@ pub(super) fn prepare(
     let mut prep = Vec::with_capacity(ds.len());
     for (i, t) in ds.trajectories.iter().enumerate() {
         let what = format!("trajectory {i}");
-        let stroke: Vec<f64> = t.euler_rad.iter().map(|e| e[0]).collect();
-        let w = published_window(&stroke).map_err(|source| JobError::Cycle {
+        let w = t.published_window().map_err(|source| JobError::Cycle {
             trajectory: i,
             source,
         })?;

@@ -23,7 +23,6 @@
 use flapssm_prssm::KernelKind;
 use flapssm_prssm::regression::{NormalEquations, RegressionKernel, SparseGpRegression};
 use flapssm_prssm::train::inducing::{KMEANS_MAX_POINTS, kmeans};
-use flapssm_wing::cycles::published_window;
 use flapssm_wing::dataset::{Standardization, Trajectory, ValidDataset};
 use serde::{Deserialize, Serialize};
 
@@ -305,8 +304,7 @@ pub fn cycle_samples(ds: &ValidDataset) -> Result<usize> {
         .iter()
         .enumerate()
         .map(|(i, t)| {
-            let stroke: Vec<f64> = t.euler_rad.iter().map(|e| e[0]).collect();
-            published_window(&stroke)
+            t.published_window()
                 .map(|w| w.duration)
                 .map_err(|source| JobError::Cycle {
                     trajectory: i,
@@ -527,6 +525,36 @@ fn refit(
     })
 }
 
+/// The static model's candidates and those of each history `h > 0` in `history_samples`
+/// (empty for `h = 0`), all scored on the same held-out samples, from the longest history on.
+/// `progress.advance(1)` after the static choice and after each history.
+fn choose_all(
+    ds: &ValidDataset,
+    stats: &Standardization,
+    history_samples: &[usize],
+    settings: &GpSettings,
+    progress: &dyn Progress,
+) -> Result<(Vec<Candidate>, Vec<Vec<Candidate>>)> {
+    let val_first = history_samples.iter().copied().max().unwrap_or(0);
+    let static_choice = choose_static(ds, stats, val_first, settings)?;
+    progress.advance(1);
+    let now = static_choice[0].input_lengthscales;
+    let histories = history_samples
+        .iter()
+        .map(|&h| {
+            let c = if h == 0 {
+                Vec::new()
+            } else {
+                let lags = tap_lags(h, settings.n_taps);
+                choose_history(ds, stats, lags, val_first, now, settings)?
+            };
+            progress.advance(1);
+            Ok(c)
+        })
+        .collect::<Result<_>>()?;
+    Ok((static_choice, histories))
+}
+
 /// The GP baselines of each history in `history_samples` (module docs), sharing the static
 /// model's choice of its length scales.
 ///
@@ -541,30 +569,21 @@ pub fn fit_histories(
     settings.check()?;
     let stats = ds.standardization()?;
     progress.start("fit GP baselines", history_samples.len() as u64 + 1);
-    let val_first = history_samples.iter().copied().max().unwrap_or(0);
-    let static_choice = choose_static(ds, &stats, val_first, settings)?;
-    progress.advance(1);
-    let now = static_choice[0].input_lengthscales;
-    let mut out = Vec::with_capacity(history_samples.len());
-    for &h in history_samples {
-        let candidates = if h == 0 {
-            static_choice.clone()
-        } else {
-            choose_history(
-                ds,
-                &stats,
-                tap_lags(h, settings.n_taps),
-                val_first,
-                now,
-                settings,
-            )?
-        };
-        let key = if h == 0 { STATIC.key } else { HISTORY.key };
-        out.push(refit(ds, stats.clone(), candidates, key, settings)?);
-        progress.advance(1);
-    }
+    let (static_choice, choices) = choose_all(ds, &stats, history_samples, settings, progress)?;
+    let models = history_samples
+        .iter()
+        .zip(choices)
+        .map(|(&h, candidates)| {
+            let (candidates, key) = if h == 0 {
+                (static_choice.clone(), STATIC.key)
+            } else {
+                (candidates, HISTORY.key)
+            };
+            refit(ds, stats.clone(), candidates, key, settings)
+        })
+        .collect::<Result<_>>()?;
     progress.finish("");
-    Ok(out)
+    Ok(models)
 }
 
 /// The GP baseline at the history, among [`GpSettings::history_cycles`] of the training
@@ -581,26 +600,15 @@ pub fn fit_best_history(
     settings.check()?;
     let period = cycle_samples(ds)?;
     let stats = ds.standardization()?;
-    progress.start(
-        "choose the GP's history",
-        settings.history_cycles.len() as u64 + 1,
-    );
     let histories: Vec<usize> = settings
         .history_cycles
         .iter()
         .map(|c| ((c * period as f64).round() as usize).max(1))
         .collect();
-    let val_first = histories.iter().copied().max().unwrap_or(0);
-    let static_choice = choose_static(ds, &stats, val_first, settings)?;
-    progress.advance(1);
-    let now = static_choice[0].input_lengthscales;
-    let mut all = Vec::new();
-    for &h in &histories {
-        let lags = tap_lags(h, settings.n_taps);
-        all.extend(choose_history(ds, &stats, lags, val_first, now, settings)?);
-        progress.advance(1);
-    }
+    progress.start("choose the GP's history", histories.len() as u64 + 1);
+    let (_, choices) = choose_all(ds, &stats, &histories, settings, progress)?;
     progress.finish("");
+    let mut all: Vec<Candidate> = choices.into_iter().flatten().collect();
     all.sort_by(|a, b| a.validation_rmse.total_cmp(&b.validation_rmse));
     progress.start("fit GP-history", 0);
     let model = refit(ds, stats, all, HISTORY.key, settings)?;

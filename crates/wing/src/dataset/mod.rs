@@ -364,6 +364,17 @@ impl Trajectory {
     pub fn is_empty(&self) -> bool {
         self.euler_rad.is_empty()
     }
+    /// The published last-full-cycle window of its stroke angle
+    /// ([`crate::cycles::published_window`]).
+    ///
+    /// # Errors
+    /// [`crate::cycles::CycleError`] for a stroke without a full cycle.
+    pub fn published_window(
+        &self,
+    ) -> Result<crate::cycles::PublishedWindow, crate::cycles::CycleError> {
+        let stroke: Vec<f64> = self.euler_rad.iter().map(|e| e[0]).collect();
+        crate::cycles::published_window(&stroke)
+    }
 }
 
 impl Dataset {
