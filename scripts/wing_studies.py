@@ -1,10 +1,11 @@
 #!/usr/bin/env python3
 """Runs the virtual wing's studies and writes what they print to docs/lab/wing-studies.md.
 
-The studies are the `#[ignore]` functions of crates/wing/tests that measure rather than
-check (minutes of simulation each, or figures with no fixed expected value). The lab record
-cites their figures from the page this script writes: each study's command, wall time and
-output, with the date and the machine. The page is written whole (temporary file, then
+The studies are the tests of crates/wing/tests whose figures the docs quote: each checks its
+figures against the values recorded here (with a tolerance) and prints them. The quick ones run
+with the test suite; the long ones (minutes of simulation) are `#[ignore]`d there and run here.
+The lab record cites their figures from the page this script writes: each study's command,
+wall time and output, with the date and the machine. The page is written whole (temporary file, then
 rename), so an interrupted run leaves the previous one in place.
 
     python3 scripts/wing_studies.py                  # all studies (about 15 minutes on 2 cores)
@@ -48,8 +49,9 @@ STUDIES = [
 HEADER = """# Virtual wing studies: their current output
 
 Written by `python3 scripts/wing_studies.py` (do not edit by hand): each study of
-`crates/wing/tests` that measures rather than checks, run with the command shown, its wall time
-and what it printed. The lab record's rounds quote earlier outputs of the same studies; the
+`crates/wing/tests` whose figures the docs quote, run with the command shown, its wall time and
+what it printed. Each checks its figures against the values recorded in its test (with a
+tolerance), so a change that moves them fails it. The lab record's rounds quote earlier outputs of the same studies; the
 figures below are the current ones.
 
 """
@@ -58,7 +60,7 @@ figures below are the current ones.
 def command(test: str, study: str) -> list[str]:
     return [
         "cargo", "test", "--release", "-q", "-p", "flapssm-wing", "--test", test, study,
-        "--", "--ignored", "--exact", "--nocapture", "--test-threads", "1",
+        "--", "--include-ignored", "--exact", "--nocapture", "--test-threads", "1",
     ]
 
 

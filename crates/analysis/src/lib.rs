@@ -11,6 +11,7 @@
 //! | [`xcorr`] | MATLAB `crosscorr`, peak |r| within one cycle | `plotter.m` |
 //! | [`kde`] | 2-D reflected Gaussian KDE, mode, 70 % HDR, contours | `ksdensity` |
 //! | [`authority`] | control-authority analysis (Fig. 5 as data, JSON/CSV) | `plotter.m` |
+//! | [`hidden`] | the authority of each input on the hidden subspace beyond the outputs, basis-free, with its chance level | — |
 //! | [`bootstrap`] | paired bootstrap of a difference of pooled RMSEs over trajectories | — |
 //! | [`scores`] | RMSE and Gaussian NLL of a sequence prediction, per-output RMSE, mean ± std over seeds (the sysid protocol) | Doerr et al. (2018) |
 //! | [`rig`] | a dataset's loads against a reference of the rig's (r, z-RMSE, 95 % band, couplings, Fig. 5 lags) | — |
@@ -26,6 +27,7 @@ pub mod authority;
 pub mod bootstrap;
 pub mod cycles_avg;
 pub mod error;
+pub mod hidden;
 pub mod kde;
 pub mod ks;
 pub mod metrics;

@@ -75,6 +75,35 @@ pub struct Interval {
     pub hi: f64,
 }
 
+/// Two-sided 95 % quantiles `t_{0.975, ν}` of Student's t for ν = 1 … 30 degrees of freedom
+/// (standard tables, 3 decimals).
+const STUDENT_T_975: [f64; 30] = [
+    12.706, 4.303, 3.182, 2.776, 2.571, 2.447, 2.365, 2.306, 2.262, 2.228, 2.201, 2.179, 2.160,
+    2.145, 2.131, 2.120, 2.110, 2.101, 2.093, 2.086, 2.080, 2.074, 2.069, 2.064, 2.060, 2.056,
+    2.052, 2.048, 2.045, 2.042,
+];
+
+/// Mean of `values` and its 95 % Student-t interval `mean ± t_{0.975, n−1} s/√n` (`s` the
+/// sample SD; the normal 1.96 beyond 30 degrees of freedom): the interval over a few
+/// independent repeats, such as training seeds. `None` for fewer than two values.
+pub fn mean_t_interval(values: &[f64]) -> Option<(f64, Interval)> {
+    let n = values.len();
+    if n < 2 {
+        return None;
+    }
+    let mean = values.iter().sum::<f64>() / n as f64;
+    let var = values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1) as f64;
+    let t = STUDENT_T_975.get(n - 2).copied().unwrap_or(1.96);
+    let half = t * (var / n as f64).sqrt();
+    Some((
+        mean,
+        Interval {
+            lo: mean - half,
+            hi: mean + half,
+        },
+    ))
+}
+
 /// Percentile `p` (in %, 0 ≤ p ≤ 100) of already **sorted** finite values, MATLAB definition
 /// (see the module docs). Cost O(1).
 ///
@@ -216,5 +245,16 @@ mod tests {
         ));
         assert!(prctile(&[1.0], 101.0).is_err());
         assert!(Rows::new(&[1.0, 2.0, 3.0], 2).is_err());
+    }
+
+    /// Two repeats: t = 12.706; the interval of {1, 3} is 2 ± 12.706 · √2/√2.
+    #[test]
+    fn t_interval_over_repeats() {
+        let (m, i) = mean_t_interval(&[1.0, 3.0]).unwrap();
+        assert_eq!(m, 2.0);
+        assert!((i.hi - 2.0 - 12.706).abs() < 1e-12 && (2.0 - i.lo - 12.706).abs() < 1e-12);
+        let (_, i) = mean_t_interval(&[1.0, 2.0, 3.0, 4.0, 5.0]).unwrap();
+        assert!((i.hi - 3.0 - 2.776 * (2.5f64 / 5.0).sqrt()).abs() < 1e-12);
+        assert!(mean_t_interval(&[1.0]).is_none());
     }
 }

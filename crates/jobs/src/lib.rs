@@ -14,6 +14,7 @@
 //! | [`evaluate`] | both models on a dataset: metrics, authority, figures, report |
 //! | [`history`] | the history curve: a GP baseline's test error against the input history it is given |
 //! | [`rig`] | a dataset on the paper's trajectories against the published model's prediction of the rig's loads |
+//! | [`known_answer`] | the published model as the plant: its draws on the paper's trajectories, and a trained PR-SSM's recovery of it |
 //! | [`own_rig`] | a user's rig: its description, raw recordings into a dataset, the virtual wing rehearsing it |
 //! | [`sweep`] | one-configuration PR-SSM sweep runs (D_x, training-set size) and their merge |
 //! | [`demo`] | the one-command demo: simulate, fit, train, evaluate (resumable) |
@@ -39,6 +40,7 @@ pub mod evaluate;
 pub mod files;
 pub mod history;
 pub mod kinematics_compare;
+pub mod known_answer;
 pub mod models;
 pub mod own_rig;
 pub mod predict;

@@ -158,13 +158,7 @@ pub fn rig_reference(
     kinematics.trajectories.truncate(n);
     kinematics.n_train = n.min(PAPER_N_TRAIN);
     let kinematics = ValidDataset::new(kinematics)?;
-    let mut standardized = model.clone();
-    standardized.normalization = Some(Normalization {
-        input_mean: input_mean.to_vec(),
-        input_std: input_std.to_vec(),
-        output_mean: vec![0.0; 5],
-        output_std: vec![1.0; 5],
-    });
+    let standardized = on_paper_inputs(model, &input_mean, &input_std);
     let period_samples = kinematics
         .trajectories
         .iter()
@@ -202,8 +196,22 @@ pub fn rig_reference(
     })
 }
 
+/// `model` (standardized units) taking the paper's physical inputs: standardized by `mean` and
+/// `std` (the paper's 512 training trajectories, [`input_statistics`]), outputs left
+/// standardized.
+pub(crate) fn on_paper_inputs(model: &PrssmModel, mean: &[f64; 7], std: &[f64; 7]) -> PrssmModel {
+    let mut standardized = model.clone();
+    standardized.normalization = Some(Normalization {
+        input_mean: mean.to_vec(),
+        input_std: std.to_vec(),
+        output_mean: vec![0.0; 5],
+        output_std: vec![1.0; 5],
+    });
+    standardized
+}
+
 /// Mean and SD (population) of the inputs over every sample of the first 512 trajectories.
-fn input_statistics(ds: &ValidDataset) -> ([f64; 7], [f64; 7]) {
+pub(crate) fn input_statistics(ds: &ValidDataset) -> ([f64; 7], [f64; 7]) {
     let rows: Vec<&[f64; 7]> = ds.trajectories[..PAPER_N_TRAIN]
         .iter()
         .flat_map(|t| t.inputs.iter())
@@ -286,13 +294,13 @@ fn standardize(outputs: &[&[[f64; 5]]]) -> Result<Vec<Vec<f64>>> {
         .collect())
 }
 
-/// Checks that `ds` holds the paper's trajectories `0..ds.len()` in the authors' order, within
-/// `reference`, with its loads.
 fn table<'a>(v: &'a [f64], c: usize, what: &str) -> Result<Rows<'a>> {
     Rows::new(v, c).map_err(analysis(what))
 }
 
-fn check_dataset(ds: &ValidDataset, reference: &RigReference) -> Result<()> {
+/// Checks that `ds` holds the paper's trajectories `0..ds.len()` in the authors' order, within
+/// `reference`, with its loads.
+pub(crate) fn check_same_trajectories(ds: &ValidDataset, reference: &RigReference) -> Result<()> {
     if ds.len() > reference.len() {
         return Err(JobError::Mismatch {
             what: "dataset for the rig check".into(),
@@ -346,7 +354,7 @@ fn check_dataset(ds: &ValidDataset, reference: &RigReference) -> Result<()> {
 /// [`JobError::Mismatch`] naming a dataset that is not on the paper's trajectories or has no
 /// loads; the analysis' errors.
 pub fn rig_check(ds: &ValidDataset, reference: &RigReference, with_lags: bool) -> Result<RigCheck> {
-    check_dataset(ds, reference)?;
+    check_same_trajectories(ds, reference)?;
     let (train, test) = agreement(&standardized_loads(ds)?, reference, with_lags)?;
     Ok(RigCheck {
         fidelity: ds

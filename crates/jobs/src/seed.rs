@@ -11,6 +11,8 @@
 //! | 7 ([`PREDICTION_STREAM`]) | open-loop prediction of trajectory `i` of a dataset |
 //! | 40 ([`SYSID_PREDICTION_STREAM`]) | sysid test-part prediction |
 //! | 41 ([`SYSID_RESTART_STREAM`]) | sysid restart training seeds |
+//! | 42 ([`DRAW_PATH_STREAM`]) | a reference model's latent path drawn on trajectory `i` |
+//! | 43 ([`DRAW_NOISE_STREAM`]) | its observation noise on trajectory `i` |
 //!
 //! The engine derives its own streams from the training seed (minibatch order, particle draws
 //! per step, initialization): `flapssm_prssm::train` documents them.
@@ -32,3 +34,9 @@ pub const SYSID_PREDICTION_STREAM: u64 = 40;
 /// Stream of the training seeds of the sysid protocol's restarts `r ≥ 1` (restart 0 trains with
 /// the seed itself).
 pub const SYSID_RESTART_STREAM: u64 = 41;
+
+/// Stream of the latent path a model draws on trajectory `i` ([`crate::known_answer`]).
+pub const DRAW_PATH_STREAM: u64 = 42;
+
+/// Stream of the observation noise added to that path.
+pub const DRAW_NOISE_STREAM: u64 = 43;

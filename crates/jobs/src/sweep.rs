@@ -12,13 +12,14 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
+use flapssm_analysis::stats::mean_t_interval;
 use flapssm_prssm::train::EpochRecord;
 use flapssm_prssm::train::fit::FitSpec;
 use flapssm_wing::dataset::{OUTPUT_NAMES, Standardization, ValidDataset};
 use serde::{Deserialize, Serialize};
 
 use crate::error::{JobError, Result};
-use crate::evaluate::paper::{ComparisonRow, SelectionPoint, selection_rows};
+use crate::evaluate::paper::{ComparisonRow, SelectionDifference, SelectionPoint, selection_rows};
 use crate::evaluate::prepared::pooled_errors;
 use crate::files::save_json;
 use crate::predict::predict_prssm;
@@ -355,6 +356,9 @@ fn full_set_points(results: &[(String, SweepResult)]) -> Vec<SweepRow> {
         .collect()
 }
 
+/// The paper's latent dimension (Methods, line 95): the reference of the D_x differences.
+const PAPER_DX: usize = 12;
+
 /// One row of the merged table.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SweepRow {
@@ -408,6 +412,10 @@ pub struct SweepTable {
     /// Per kind and value: mean and spread over seeds ([`SweepTable::selection`]).
     #[serde(default)]
     pub selection: Vec<(SweepKind, SelectionPoint)>,
+    /// Each value against its kind's reference (D_x 12; the largest training set), paired by
+    /// seed ([`SweepTable::differences`]).
+    #[serde(default)]
+    pub differences: Vec<(SweepKind, SelectionDifference)>,
     /// The paper's two selections beside these results
     /// ([`crate::evaluate::paper::selection_rows`]).
     #[serde(default)]
@@ -438,13 +446,18 @@ impl SweepTable {
         let mut table = Self {
             rows,
             selection: Vec::new(),
+            differences: Vec::new(),
             paper_comparison: Vec::new(),
         };
         let (dx, sizes) = (
             table.selection(SweepKind::Dx),
             table.selection(SweepKind::DataSize),
         );
-        table.paper_comparison = selection_rows(&dx, &sizes);
+        table.differences = [SweepKind::Dx, SweepKind::DataSize]
+            .into_iter()
+            .flat_map(|k| table.differences(k).into_iter().map(move |d| (k, d)))
+            .collect();
+        table.paper_comparison = selection_rows(&dx, &sizes, &table.differences);
         table.selection = dx
             .into_iter()
             .map(|p| (SweepKind::Dx, p))
@@ -488,6 +501,52 @@ impl SweepTable {
                     test_spread: spread(&test),
                     train_spread: spread(&train),
                     seeds: rows.len(),
+                })
+            })
+            .collect()
+    }
+
+    /// Every other value of `kind` against its reference (D_x 12, the paper's choice; the
+    /// largest training set), paired by seed: per seed both ran, the difference of overall test
+    /// RMSE; its mean with a 95 % Student-t interval over those seeds
+    /// ([`flapssm_analysis::stats::mean_t_interval`]). Empty without the reference value or a
+    /// test set.
+    pub fn differences(&self, kind: SweepKind) -> Vec<SelectionDifference> {
+        let rows: Vec<&SweepRow> = self.rows.iter().filter(|r| r.kind == kind).collect();
+        let reference = match kind {
+            SweepKind::Dx => rows.iter().find(|r| r.value == PAPER_DX).map(|r| r.value),
+            SweepKind::DataSize => rows.iter().map(|r| r.value).max(),
+        };
+        let Some(reference) = reference else {
+            return Vec::new();
+        };
+        let test_of = |value: usize, seed: u64| {
+            rows.iter()
+                .find(|r| r.value == value && r.seed == seed)
+                .and_then(|r| r.test_overall)
+        };
+        let mut values: Vec<usize> = rows.iter().map(|r| r.value).collect();
+        values.dedup();
+        values
+            .into_iter()
+            .filter(|&v| v != reference)
+            .filter_map(|value| {
+                let diffs: Vec<f64> = rows
+                    .iter()
+                    .filter(|r| r.value == value)
+                    .filter_map(|r| Some(r.test_overall? - test_of(reference, r.seed)?))
+                    .collect();
+                if diffs.is_empty() {
+                    return None;
+                }
+                let interval = mean_t_interval(&diffs);
+                Some(SelectionDifference {
+                    value,
+                    reference,
+                    seeds: diffs.len(),
+                    mean: diffs.iter().sum::<f64>() / diffs.len() as f64,
+                    interval: interval.map(|(_, i)| i),
+                    significant: interval.is_some_and(|(_, i)| i.lo > 0.0 || i.hi < 0.0),
                 })
             })
             .collect()
@@ -719,6 +778,7 @@ mod tests {
                 row(SweepKind::DataSize, 64, 0, 0.10, 0.50),
             ],
             selection: Vec::new(),
+            differences: Vec::new(),
             paper_comparison: Vec::new(),
         };
         let dx = table.selection(SweepKind::Dx);
@@ -726,7 +786,7 @@ mod tests {
         assert_eq!((dx[0].value, dx[0].seeds, dx[1].seeds), (8, 2, 1));
         assert!((dx[0].test_rmse - 0.43).abs() < 1e-12 && (dx[0].test_spread - 0.06).abs() < 1e-12);
         assert!((dx[0].train_rmse - 0.32).abs() < 1e-12 && dx[1].test_spread == 0.0);
-        let rows = selection_rows(&dx, &table.selection(SweepKind::DataSize));
+        let rows = selection_rows(&dx, &table.selection(SweepKind::DataSize), &[]);
         assert_eq!(rows.len(), 2);
         assert!(
             rows[0]
@@ -734,5 +794,50 @@ mod tests {
                 .starts_with("8: 0.430 ± 0.060 (2 seeds); 12: 0.300")
         );
         assert!(rows[1].flapssm.starts_with("64: 0.100 ± 0.000 / 0.500"));
+    }
+
+    /// Each value against the reference, paired by seed: a consistent gap over three seeds is
+    /// significant, two seeds that disagree are not, a lone seed has no interval, and a value
+    /// run only with seeds the reference lacks is left out.
+    #[test]
+    fn differences_are_paired_by_seed_with_a_t_interval() {
+        let table = SweepTable {
+            rows: vec![
+                row(SweepKind::Dx, 8, 0, 0.2, 0.31),
+                row(SweepKind::Dx, 8, 1, 0.2, 0.32),
+                row(SweepKind::Dx, 8, 2, 0.2, 0.33),
+                row(SweepKind::Dx, 12, 0, 0.2, 0.30),
+                row(SweepKind::Dx, 12, 1, 0.2, 0.31),
+                row(SweepKind::Dx, 12, 2, 0.2, 0.32),
+                row(SweepKind::Dx, 16, 0, 0.2, 0.28),
+                row(SweepKind::Dx, 16, 1, 0.2, 0.33),
+                row(SweepKind::Dx, 20, 5, 0.2, 0.30),
+                row(SweepKind::DataSize, 64, 0, 0.2, 0.40),
+                row(SweepKind::DataSize, 512, 0, 0.2, 0.30),
+            ],
+            selection: Vec::new(),
+            differences: Vec::new(),
+            paper_comparison: Vec::new(),
+        };
+        let dx = table.differences(SweepKind::Dx);
+        assert_eq!(dx.len(), 2, "{dx:?}");
+        let (d8, d16) = (&dx[0], &dx[1]);
+        assert_eq!((d8.value, d8.reference, d8.seeds), (8, 12, 3));
+        assert!((d8.mean - 0.01).abs() < 1e-12 && d8.significant, "{d8:?}");
+        let i = d16.interval.unwrap();
+        assert!(i.lo < 0.0 && i.hi > 0.0 && !d16.significant, "{d16:?}");
+        assert_eq!(
+            d16.to_string(),
+            format!(
+                "16 − 12: {:+.3} [{:+.3}, {:+.3}] (2 seeds)",
+                d16.mean, i.lo, i.hi
+            )
+        );
+        let size = table.differences(SweepKind::DataSize);
+        assert_eq!(
+            (size[0].value, size[0].reference, size[0].seeds),
+            (64, 512, 1)
+        );
+        assert!(size[0].interval.is_none() && !size[0].significant);
     }
 }

@@ -2,7 +2,9 @@
 
 mod common;
 
-use common::{blade, figure_eight_hover_state, lift_n, mirrored, robofly_hover_state};
+use common::{
+    assert_recorded, blade, figure_eight_hover_state, lift_n, mirrored, robofly_hover_state,
+};
 
 use flapssm_wing::aero::blade_element::BladeElement;
 use flapssm_wing::aero::quasi_steady::{
@@ -841,15 +843,21 @@ fn l2_outputs_are_insensitive_to_a_small_parameter_change() {
 }
 
 /// The same 0.1 % core change on the measured-like default generator and on the paper's
-/// measured trajectories (24 each, noise-free L2), for the record (docs/vortex-method.md). A
-/// study, not a check: `cargo test --release -p flapssm-wing --test physics
-/// l2_sensitivity_study -- --ignored --nocapture`.
+/// measured trajectories (24 each, noise-free L2), checked against its record
+/// (docs/vortex-method.md); `cargo test --release -p flapssm-wing --test physics
+/// l2_sensitivity_study -- --nocapture` prints it.
 #[test]
-#[ignore = "study: prints the L2 sensitivity on the default and the paper's kinematics; run by scripts/wing_studies.py, output in docs/lab/wing-studies.md"]
 fn l2_sensitivity_study() {
     let [d, p] = l2_sensitivity(&l2_config());
     println!("default generator: rms change from r_c0 × 1.001 (σ): {d:.3?}");
     println!("paper's trajectories: rms change from r_c0 × 1.001 (σ): {p:.3?}");
+    assert_recorded(
+        "default generator",
+        &d,
+        &[0.280, 0.239, 0.214, 0.253, 0.309],
+        0.01,
+    );
+    assert_recorded("paper", &p, &[0.227, 0.201, 0.209, 0.241, 0.263], 0.01);
 }
 
 /// The default wing at L2.
@@ -914,16 +922,21 @@ fn l2_sensitivity(base: &VirtualWingConfig) -> [[f64; 5]; 2] {
 /// Trajectories whose raw (250 Hz, noise-free) L2 peak |F_x| exceeds 1.5× the L0 peak + 1 N
 /// (the burst criterion of docs/vortex-method.md), among the first 150 of the hovering
 /// generator, the default generator (seed 1, 548) and the paper's measured trajectories. A
-/// study, not a check: `cargo test --release -p flapssm-wing --test physics l2_burst_study --
+/// study checked against its record: `cargo test --release -p flapssm-wing --test physics l2_burst_study --
 /// --ignored --nocapture`.
 #[test]
-#[ignore = "study: counts L2 bursts on three trajectory sets; run by scripts/wing_studies.py, output in docs/lab/wing-studies.md"]
+#[ignore = "study (≈ 2 min): L2 bursts on three trajectory sets against their record; run by scripts/wing_studies.py, output in docs/lab/wing-studies.md"]
 fn l2_burst_study() {
-    for (name, bursts, worst) in l2_bursts(&l2_config(), true) {
+    let found = l2_bursts(&l2_config(), true);
+    for (name, bursts, worst) in &found {
         println!(
             "{name}: {bursts} of 150 with a burst; worst L2 peak / (1.5·L0 peak + 1 N) = {worst:.2}"
         );
     }
+    let counts: Vec<f64> = found.iter().map(|f| f.1 as f64).collect();
+    assert_recorded("bursts", &counts, &[8.0, 10.0, 11.0], 1.0);
+    let worst: Vec<f64> = found.iter().map(|f| f.2).collect();
+    assert_recorded("worst ratio", &worst, &[3.30, 1.86, 2.65], 0.05);
 }
 
 /// (set, trajectories with a burst among the first 150, worst ratio) of the wing `l2` on the
@@ -983,22 +996,37 @@ fn l2_bursts(l2: &VirtualWingConfig, hovering: bool) -> Vec<(&'static str, usize
 /// 0.5 s and 3.72 s, identical motion after the longer one) should give the same noise-free
 /// loads within a cycle or two. Prints the rms difference of each output per cycle after the
 /// longer ramp, in standard deviations, on 12 default-generator trajectories, for L1 and L2.
-/// A study, not a check: `cargo test --release -p flapssm-wing --test physics
-/// repeatability_study -- --ignored --nocapture`.
+/// Checked against its record; `cargo test --release -p flapssm-wing --test physics
+/// repeatability_study -- --nocapture` prints it.
 #[test]
-#[ignore = "study: loads from two histories of the same kinematics; run by scripts/wing_studies.py, output in docs/lab/wing-studies.md"]
 fn repeatability_study() {
-    for fidelity in [Fidelity::L1, Fidelity::L2] {
+    // Recorded: L1 forgets within a cycle; L2's free wake keeps 0.05–0.17 σ.
+    let recorded = [
+        (Fidelity::L1, [0.075, 0.005, 0.004, 0.008], 0.005),
+        (Fidelity::L2, [0.199, 0.170, 0.131, 0.142], 0.01),
+    ];
+    for (fidelity, worst_per_cycle, tol) in recorded {
         let cfg = VirtualWingConfig {
             fidelity,
             ..VirtualWingConfig::ideal()
         };
-        for (cycle, rel) in repeatability(&cfg, 12).iter().enumerate() {
+        let rep = repeatability(&cfg, 12);
+        for (cycle, rel) in rep.iter().enumerate() {
             println!(
                 "{fidelity:?}, cycle {} after the long ramp: rms difference / σ {rel:.3?}",
                 cycle + 1
             );
         }
+        let worst: Vec<f64> = rep
+            .iter()
+            .map(|r| r.iter().copied().fold(0.0, f64::max))
+            .collect();
+        assert_recorded(
+            &format!("{fidelity:?} worst output per cycle"),
+            &worst,
+            &worst_per_cycle,
+            tol,
+        );
     }
 }
 
@@ -1079,10 +1107,10 @@ fn l2_frozen_wake_is_not_chaotic() {
 /// frozen wake, and a frozen wake carried down by an induced inflow (w = k·U_ref, or from momentum
 /// theory). Prints the mean C_L of the flat-stroke and the figure-of-eight hover (cycles 2–8),
 /// the r_c0 × 1.001 change, the repeatability in the 2nd and
-/// 3rd cycles and the bursts. A study, not a check: `cargo test --release -p flapssm-wing --test
+/// 3rd cycles and the bursts; the C_L checked against its record. A study: `cargo test --release -p flapssm-wing --test
 /// physics l2_wake_motion_study -- --ignored --nocapture` (≈ 8 min on 2 cores).
 #[test]
-#[ignore = "study: the free and the frozen wake on the three criteria; run by scripts/wing_studies.py, output in docs/lab/wing-studies.md"]
+#[ignore = "study (≈ 8 min): the free and the frozen wake on the three criteria, C_L against its record; run by scripts/wing_studies.py, output in docs/lab/wing-studies.md"]
 fn l2_wake_motion_study() {
     let uniform = |ratio| Inflow::Uniform { ratio };
     let variants = [
@@ -1094,7 +1122,17 @@ fn l2_wake_motion_study() {
         ("frozen, momentum", WakeMotion::Frozen, Inflow::Momentum),
         ("free, momentum", WakeMotion::Free, Inflow::Momentum),
     ];
-    for (name, motion, inflow) in variants {
+    // Recorded mean C_L (flat stroke, figure-of-eight) of each variant.
+    let recorded = [
+        [1.622, 1.631],
+        [2.883, 2.165],
+        [2.281, 1.672],
+        [2.078, 1.145],
+        [2.009, 0.870],
+        [1.987, 1.260],
+        [1.369, 1.179],
+    ];
+    for ((name, motion, inflow), cl_recorded) in variants.into_iter().zip(recorded) {
         let mut cfg = l2_config();
         cfg.l2.ldvm.wake_motion = motion;
         cfg.l2.inflow = inflow;
@@ -1112,15 +1150,21 @@ fn l2_wake_motion_study() {
              two histories, 2nd cycle {:.3?} 3rd {:.3?}; bursts {bursts:?}",
             rep[1], rep[2]
         );
+        assert_recorded(
+            &format!("{name}: C_L"),
+            &[cl_flat, cl_mean],
+            &cl_recorded,
+            0.02,
+        );
     }
 }
 
 /// L3 (vortex lattice) on the criteria of a rig's loads (docs/vortex-method.md, "Current
 /// figures"): hover lift on the flat and the figure-of-eight stroke, the r_c0 × 1.001 change, two
-/// histories per cycle, bursts. A study, not a check: `cargo test --release -p flapssm-wing --test physics l3_study --
+/// histories per cycle, bursts, checked against its record. A study: `cargo test --release -p flapssm-wing --test physics l3_study --
 /// --ignored --nocapture`.
 #[test]
-#[ignore = "study: the L3 vortex lattice on the criteria of a rig's loads; run by scripts/wing_studies.py, output in docs/lab/wing-studies.md"]
+#[ignore = "study (≈ 2 min): the L3 vortex lattice on the criteria of a rig's loads against its record; run by scripts/wing_studies.py, output in docs/lab/wing-studies.md"]
 fn l3_study() {
     let cfg = VirtualWingConfig {
         fidelity: Fidelity::L3,
@@ -1134,14 +1178,30 @@ fn l3_study() {
         mean(&flat),
         mean(&eight)
     );
+    assert_recorded("C_L", &[mean(&flat), mean(&eight)], &[1.390, 0.965], 0.02);
     let [d, p] = l2_sensitivity(&cfg);
     println!("r_c0 × 1.001 (σ): default {d:.3?} paper {p:.3?}");
-    for (cycle, rel) in repeatability(&cfg, 12).iter().enumerate() {
+    assert_recorded("r_c0 × 1.001", &[d, p].concat(), &[0.0; 10], 0.002);
+    let rep = repeatability(&cfg, 12);
+    for (cycle, rel) in rep.iter().enumerate() {
         println!("two histories, cycle {}: {rel:.3?}", cycle + 1);
     }
-    for (name, bursts, worst) in l2_bursts(&cfg, false) {
+    let worst: Vec<f64> = rep
+        .iter()
+        .map(|r| r.iter().copied().fold(0.0, f64::max))
+        .collect();
+    assert_recorded(
+        "two histories, worst output per cycle",
+        &worst,
+        &[0.355, 0.095, 0.054, 0.047],
+        0.01,
+    );
+    let bursts = l2_bursts(&cfg, false);
+    for (name, bursts, worst) in &bursts {
         println!("{name}: {bursts} of 150 with a burst; worst ratio {worst:.2}");
     }
+    let counts: Vec<f64> = bursts.iter().map(|b| b.1 as f64).collect();
+    assert_recorded("bursts", &counts, &[0.0, 0.0], 0.0);
 }
 
 fn mean(v: &[f64]) -> f64 {

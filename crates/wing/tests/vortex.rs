@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::{blade, lift_n, mirrored, robofly_hover_state};
+use common::{assert_recorded, blade, lift_n, mirrored, robofly_hover_state};
 use std::f64::consts::PI;
 
 use flapssm_wing::vortex::{Ldvm, LdvmParams, PlateState, SectionLoads, VortexKind};
@@ -648,10 +648,11 @@ fn kelvin_total_circulation_is_zero_without_decay() {
     assert!(worst < 1e-12 * g_max.max(1e-300) * 100.0);
 }
 
-/// Measurement (ignored, open gap): 2-D hover, |C_N| (smoothed over 1/300 cycle) at 600, 1200
-/// and 2400 steps per cycle.
+/// Study of an open gap (docs/vortex-method.md): 2-D hover, |C_N| (smoothed over 1/300 cycle)
+/// at 600, 1200 and 2400 steps per cycle; the peak grows with resolution (recorded 6.2, 6.8,
+/// 7.5) while the median holds (4.1–4.3). Checked against its record; printed for
+/// docs/lab/wing-studies.md.
 #[test]
-#[ignore = "measurement of an open gap (docs/vortex-method.md); run by scripts/wing_studies.py, output in docs/lab/wing-studies.md"]
 fn study_hover_spikes() {
     let h = Hover {
         c: 0.06,
@@ -660,7 +661,8 @@ fn study_hover_spikes() {
         mirror: false,
     };
     let p = LdvmParams::default();
-    for spc in [600usize, 1200, 2400] {
+    let recorded = [[6.2, 4.1], [6.8, 4.3], [7.5, 4.3]];
+    for (spc, max_median) in [600usize, 1200, 2400].into_iter().zip(recorded) {
         let (_, a) = h.run(p, 3.0, spc);
         let q = 0.5 * p.rho_kg_m3 * h.u_ref().powi(2) * h.c;
         let cn: Vec<f64> = a.iter().map(|l| l.normal_n_m / q).collect();
@@ -676,6 +678,13 @@ fn study_hover_spikes() {
             cn[..spc].iter().sum::<f64>() / spc as f64,
             cn[spc..2 * spc].iter().sum::<f64>() / spc as f64,
             cn[2 * spc..].iter().sum::<f64>() / spc as f64
+        );
+        let (max, median) = (s[s.len() - 1], s[s.len() / 2]);
+        assert_recorded(
+            &format!("spc {spc}: max, median"),
+            &[max, median],
+            &max_median,
+            0.06,
         );
     }
 }
@@ -899,30 +908,45 @@ fn wake_capture_measure() -> (f64, f64, f64) {
     (d_full / m, d_cut / m, q_sum / m)
 }
 
-/// Measurement (ignored, open gap): wake capture at r_cp, with and without the wake.
+/// Study of an open gap: wake capture at r_cp, with and without the wake (recorded: +1.205 N/m
+/// with the wake, −0.778 N/m with it deleted, QS 2.191 N/m), checked against its record.
 #[test]
-#[ignore = "measurement of an open gap (docs/vortex-method.md); run by scripts/wing_studies.py, output in docs/lab/wing-studies.md"]
 fn study_wake_capture() {
     let (a, b, q) = wake_capture_measure();
     println!("after reversal: (L2 − QS) {a:.4} N/m with wake, {b:.4} N/m wake deleted; QS {q:.4}");
+    assert_recorded(
+        "wake capture",
+        &[a, b, q],
+        &[1.2046, -0.7778, 2.1913],
+        0.005,
+    );
 }
 
-/// Measurement (ignored, open gap): per-cycle peak |C_Fx| of the L2 Robofly hover.
+/// Study of an open gap: per-cycle peak |C_Fx| of the L2 Robofly hover (recorded 3.04, 2.67,
+/// 2.67, 2.62), checked against its record.
 #[test]
-#[ignore = "measurement of an open gap (docs/vortex-method.md); run by scripts/wing_studies.py, output in docs/lab/wing-studies.md"]
 fn study_wing_hover_trace() {
     let (states, dt) = hover_states(F_HOVER, 4);
     let y = run_blade(&states, dt, 2);
     let u_ref = 0.235 * 4.0 * 80f64.to_radians() * F_HOVER;
     let q_s = 0.5 * 800.0 * 0.0108 * u_ref * u_ref;
-    for cyc in 0..4 {
-        let m = max_abs(
-            y[cyc * PER_CYCLE + 5..(cyc + 1) * PER_CYCLE]
-                .iter()
-                .map(|v| v[0] / q_s),
-        );
-        println!("cycle {cyc}: max |C_Fx| {m:.2}");
-    }
+    let peaks: Vec<f64> = (0..4)
+        .map(|cyc| {
+            let m = max_abs(
+                y[cyc * PER_CYCLE + 5..(cyc + 1) * PER_CYCLE]
+                    .iter()
+                    .map(|v| v[0] / q_s),
+            );
+            println!("cycle {cyc}: max |C_Fx| {m:.2}");
+            m
+        })
+        .collect();
+    assert_recorded(
+        "max |C_Fx| per cycle",
+        &peaks,
+        &[3.04, 2.67, 2.67, 2.62],
+        0.02,
+    );
 }
 
 /// Regressions of the r_cp strip over 6 hover cycles.
@@ -1103,11 +1127,11 @@ fn wake_capture_on_paper(n: usize) -> (f64, f64, f64, usize, usize) {
     (d_full / mf, d_cut / mf, q_sum / mf, m, positive)
 }
 
-/// Measurement: wake capture on the paper's 548 measured trajectories (docs/vortex-method.md,
-/// "Wake capture on the default data"). `cargo test --release -p flapssm-wing --test vortex
+/// Study: wake capture on the paper's 548 measured trajectories (docs/vortex-method.md,
+/// "Wake capture on the default data"), checked against its record. `cargo test --release -p flapssm-wing --test vortex
 /// study_wake_capture_paper -- --ignored --nocapture`.
 #[test]
-#[ignore = "measurement (about a minute); run by scripts/wing_studies.py, output in docs/lab/wing-studies.md"]
+#[ignore = "study (≈ 2 min), checked against its record; run by scripts/wing_studies.py, output in docs/lab/wing-studies.md"]
 fn study_wake_capture_paper() {
     let (a, b, q, m, pos) = wake_capture_on_paper(548);
     println!(
@@ -1115,6 +1139,8 @@ fn study_wake_capture_paper() {
          (L2 − QS) {a:.4} N/m with the wake, {b:.4} N/m with it deleted; QS {q:.4} N/m; \
          kept > deleted on {pos} of 548 trajectories"
     );
+    assert_recorded("wake capture", &[a, b, q], &[0.2329, 0.0810, 0.5454], 0.005);
+    assert_recorded("kept > deleted", &[pos as f64], &[311.0], 5.0);
 }
 
 /// The chordwise load in attached flow against its closed form: for the plate started
@@ -1243,15 +1269,19 @@ fn rotating_plate_chordwise_force_equals_the_impulse() {
     }
 }
 
-/// Study (ignored; `cargo test --release -p flapssm-wing --test vortex
-/// study_chordwise_force_with_lev_shedding -- --ignored --nocapture`): the Eldredge pitch-up
-/// with LEV shedding (LESP_crit 0.11), the chordwise force of the pressure integral (the LE
-/// suction held at ρπc(LESP_crit·U)²) against the impulse's, smoothed over ±0.075 t*, at two
-/// time steps.
+/// Study, checked against its record: the Eldredge pitch-up with LEV shedding (LESP_crit
+/// 0.11), the chordwise force of the pressure integral (the LE suction held at
+/// ρπc(LESP_crit·U)²) against the impulse's, smoothed over ±0.075 t*, at two time steps
+/// (`cargo test --release -p flapssm-wing --test vortex study_chordwise_force_with_lev_shedding
+/// -- --nocapture` prints it).
 #[test]
-#[ignore = "study: the chordwise force with LEV shedding at two time steps; run by scripts/wing_studies.py, output in docs/lab/wing-studies.md"]
 fn study_chordwise_force_with_lev_shedding() {
-    for dt in [0.015, 0.0075] {
+    // Recorded mean C_T, (pressure, impulse) per window.
+    let recorded = [
+        [[-0.074, -0.067], [-0.076, -0.082], [-0.076, -0.091]],
+        [[-0.074, -0.116], [-0.076, -0.088], [-0.076, -0.093]],
+    ];
+    for (dt, windows) in [0.015, 0.0075].into_iter().zip(recorded) {
         let r = eldredge_run_with(eldredge, dt);
         let h = (0.075 / dt).round() as usize;
         let (ct, cti) = (smooth(&r.ct, h), smooth(&r.ct_impulse, h));
@@ -1264,12 +1294,14 @@ fn study_chordwise_force_with_lev_shedding() {
                     .collect();
             sel.iter().sum::<f64>() / sel.len() as f64
         };
-        for (lo, hi) in [(1.0, ELDREDGE_T2), (ELDREDGE_T2, 3.0), (3.0, 5.0)] {
+        let spans = [(1.0, ELDREDGE_T2), (ELDREDGE_T2, 3.0), (3.0, 5.0)];
+        for ((lo, hi), want) in spans.into_iter().zip(windows) {
+            let got = [mean(&ct, lo, hi), mean(&cti, lo, hi)];
             println!(
                 "dt* = {dt}: t* in [{lo:.2}, {hi:.2}): mean C_T pressure {:.3}, impulse {:.3}",
-                mean(&ct, lo, hi),
-                mean(&cti, lo, hi)
+                got[0], got[1]
             );
+            assert_recorded(&format!("dt* {dt}, t* from {lo:.2}"), &got, &want, 0.002);
         }
     }
 }
@@ -1323,10 +1355,10 @@ fn strip_peaks(states: &[EulerState], dt: f64, trace: bool) -> (f64, f64, usize,
 /// Bursts of one L2 strip at r_cp on the first 150 of the paper's measured trajectories: peak
 /// |N'| after the first second above 1.5× the quasi-steady peak + [`BURST_MARGIN_N_M`]; prints
 /// each bursting trajectory, then the solver's diagnostics around the worst one's peak
-/// (docs/vortex-method.md, "Open gaps"). A study: `cargo test --release -p flapssm-wing --test
-/// vortex study_strip_bursts_paper -- --ignored --nocapture` (about 20 s).
+/// (docs/vortex-method.md, "Open gaps"). A study checked against its record (11 of 150, worst
+/// ratio 3.83 on trajectory 112): `cargo test --release -p flapssm-wing --test vortex
+/// study_strip_bursts_paper -- --nocapture` prints it (about 20 s).
 #[test]
-#[ignore = "study: bursts of the L2 strip on the paper's trajectories; run by scripts/wing_studies.py, output in docs/lab/wing-studies.md"]
 fn study_strip_bursts_paper() {
     use flapssm_wing::trajectories::SamplingConfig;
     use flapssm_wing::trajectories::measured::raw_states;
@@ -1359,6 +1391,13 @@ fn study_strip_bursts_paper() {
     for line in &lines[at.saturating_sub(12)..(at + 8).min(lines.len())] {
         println!("{line}");
     }
+    assert_recorded(
+        "bursts, worst ratio",
+        &[bursts as f64, worst.0],
+        &[11.0, 3.83],
+        0.05,
+    );
+    assert_eq!(worst.1, 112, "the worst trajectory moved");
 }
 
 /// A frozen wake ([`WakeMotion::Frozen`]) stays where it was shed, in the frame of the fluid at

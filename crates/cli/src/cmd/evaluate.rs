@@ -169,6 +169,20 @@ pub fn run(a: EvaluateArgs) -> anyhow::Result<()> {
             c.verdict()
         );
     }
+    for h in &r.hidden_authority {
+        println!(
+            "hidden subspace ({} dims) ← {}: R {:.2} lag {:.3} (chance {:.2}), excess {:+.3} [{:+.3}, {:+.3}]{}",
+            h.dimension,
+            h.input,
+            h.median_r,
+            h.median_lag_cycles,
+            h.chance_median_r,
+            h.excess,
+            h.excess_interval.lo,
+            h.excess_interval.hi,
+            if h.above_chance { " above chance" } else { "" }
+        );
+    }
     println!(
         "wrote {} (report.html, metrics.json, figures)",
         a.out.display()

@@ -6,6 +6,9 @@ use std::time::Instant;
 
 use anyhow::Context;
 use clap::{Args, Subcommand};
+use flapssm_jobs::known_answer::{
+    DRAW_UNITS, RECOVERY_FILES, recovery, reference_draws, write_recovery,
+};
 use flapssm_jobs::rig::{
     MountFitSettings, RIG_FILES, RigSettings, fit_mount, load_reference_model, rig_check,
     rig_reference, write_rig_check,
@@ -36,6 +39,44 @@ enum RigCommand {
     /// The published 2-D hovering case (Wang, Birch & Dickinson 2004) through every fidelity:
     /// lift and drag histories against the experiment and two computations.
     Wang2004(Wang2004Args),
+    /// A known answer at the paper's scale: loads drawn from the reference model on the paper's
+    /// 548 measured trajectories (its standardized units), a dataset to train a PR-SSM on.
+    Draws(DrawsArgs),
+    /// How well a PR-SSM trained on `rig draws` recovers the model that drew them, on the 36
+    /// test trajectories: per channel its mean against the drawing model's, and both against the
+    /// draws with a paired bootstrap interval.
+    Recovery(RecoveryArgs),
+}
+
+#[derive(Args)]
+struct DrawsArgs {
+    /// The drawing model: the published parameter file (…/bayiz2021-prssm/reference.npz) or a
+    /// model file imported from it.
+    #[arg(long, value_name = "FILE")]
+    reference: PathBuf,
+    /// Seed of the draws (same seed, identical file).
+    #[arg(long, value_name = "S", default_value_t = 1)]
+    seed: u64,
+    /// Output dataset file (.npz).
+    #[arg(long, value_name = "FILE")]
+    out: PathBuf,
+    /// Hide the progress bar.
+    #[arg(long)]
+    quiet: bool,
+}
+
+#[derive(Args)]
+struct RecoveryArgs {
+    /// The draws (`flapssm rig draws`) the model was trained on.
+    dataset: PathBuf,
+    /// The trained PR-SSM (.json, `flapssm train`).
+    #[arg(long, value_name = "FILE")]
+    prssm: PathBuf,
+    #[command(flatten)]
+    reference: ReferenceArgs,
+    /// Output directory: recovery.json and recovery.md.
+    #[arg(long, value_name = "DIR")]
+    out: PathBuf,
 }
 
 #[derive(Args)]
@@ -143,7 +184,62 @@ pub fn run(args: RigArgs) -> anyhow::Result<()> {
         RigCommand::Check(a) => check(a),
         RigCommand::FitMount(a) => fit(a),
         RigCommand::Wang2004(a) => wang(a),
+        RigCommand::Draws(a) => draws(a),
+        RigCommand::Recovery(a) => recover(a),
     }
+}
+
+fn draws(a: DrawsArgs) -> anyhow::Result<()> {
+    let start = Instant::now();
+    flapssm_jobs::files::check_outputs(&[&a.out], &[&a.reference])?;
+    let model = load_reference_model(&a.reference)?;
+    let bars = Bars::new();
+    let ds = reference_draws(&model, a.seed, progress_of(a.quiet, &bars))
+        .context("drawing from the reference model")?;
+    ds.save(&a.out)
+        .with_context(|| format!("writing {}", a.out.display()))?;
+    println!(
+        "wrote {}: the paper's {} measured trajectories ({} train), loads drawn from {} (seed {}, {}) in {:.1} s",
+        a.out.display(),
+        ds.len(),
+        ds.n_train,
+        a.reference.display(),
+        a.seed,
+        DRAW_UNITS,
+        start.elapsed().as_secs_f64()
+    );
+    Ok(())
+}
+
+fn recover(a: RecoveryArgs) -> anyhow::Result<()> {
+    let start = Instant::now();
+    flapssm_jobs::files::check_output_dir(
+        &a.out,
+        &RECOVERY_FILES,
+        &[&a.dataset, &a.prssm, &a.reference.reference],
+    )?;
+    let ds = flapssm_wing::dataset::Dataset::load(&a.dataset)
+        .with_context(|| format!("reading dataset {}", a.dataset.display()))?;
+    let reference = load_reference_model(&a.reference.reference)?;
+    let trained = flapssm_prssm::PrssmModel::load(&a.prssm)
+        .with_context(|| format!("reading model {}", a.prssm.display()))?;
+    let bars = Bars::new();
+    let progress = progress_of(a.reference.quiet, &bars);
+    let result = recovery(&trained, &reference, &ds, &a.reference.settings(), progress)
+        .with_context(|| format!("scoring {} on {}", a.prssm.display(), a.dataset.display()))?;
+    let title = format!(
+        "{} recovering {}",
+        a.prssm.display(),
+        a.reference.reference.display()
+    );
+    write_recovery(&a.out, &result, &title)?;
+    print!("{}", result.markdown(&title));
+    println!(
+        "\nwrote {} ({:.1} s)",
+        a.out.display(),
+        start.elapsed().as_secs_f64()
+    );
+    Ok(())
 }
 
 fn progress_of(quiet: bool, bars: &Bars) -> &dyn Progress {

@@ -4,11 +4,12 @@
 use std::path::Path;
 
 use flapssm_analysis::authority::{AuthoritySummary, AuthorityTrajectory, PeakTable, peak_table};
+use flapssm_analysis::hidden::{HiddenTrajectory, hidden_authority};
 use flapssm_wing::dataset::ValidDataset;
 
-use super::paper::fig5_pairs;
+use super::paper::{FIG5_CLAIMS, fig5_pairs};
 use super::prepared::{Prepared, rows};
-use super::report::{AuthorityFinding, EvalOptions, INPUT_LABELS};
+use super::report::{AuthorityFinding, EvalOptions, HiddenFinding, INPUT_LABELS};
 use crate::error::{Result, analysis};
 use crate::models::ModelPrediction;
 
@@ -19,6 +20,7 @@ pub(super) struct Authority {
     pub(super) state_names: Vec<String>,
     pub(super) input_names: Vec<String>,
     pub(super) findings: Vec<AuthorityFinding>,
+    pub(super) hidden: Vec<HiddenFinding>,
 }
 
 impl Authority {
@@ -88,11 +90,67 @@ pub(super) fn authority(
             })
         })
         .collect();
+    let hidden = if dx > N_OUTPUT {
+        hidden_findings(&auth_traj, opts)?
+    } else {
+        Vec::new()
+    };
     Ok(Authority {
         table,
         summary,
         state_names,
         input_names,
         findings,
+        hidden,
     })
+}
+
+/// The output states x1..x5.
+const N_OUTPUT: usize = 5;
+
+/// Every input's authority on the hidden subspace (states beyond x5), beside what the paper
+/// says of it on single hidden states.
+fn hidden_findings(
+    trajectories: &[AuthorityTrajectory<'_>],
+    opts: &EvalOptions,
+) -> Result<Vec<HiddenFinding>> {
+    let trajectories: Vec<HiddenTrajectory<'_>> = trajectories
+        .iter()
+        .map(|t| HiddenTrajectory {
+            inputs: t.inputs,
+            states: t.states,
+            period_samples: t.period_samples,
+        })
+        .collect();
+    let found = hidden_authority(&trajectories, N_OUTPUT, &opts.authority, opts.seed)
+        .map_err(analysis("authority on the hidden subspace"))?;
+    Ok(found
+        .into_iter()
+        .map(|h| {
+            let input = INPUT_LABELS[h.input];
+            let paper = FIG5_CLAIMS
+                .iter()
+                .filter(|c| c.inputs.contains(&input))
+                .flat_map(|c| {
+                    c.states
+                        .iter()
+                        .filter(|&&s| s > N_OUTPUT)
+                        .map(move |s| format!("x{s}: {}", c.text))
+                })
+                .collect::<Vec<_>>()
+                .join("; ");
+            HiddenFinding {
+                input: input.to_string(),
+                paper,
+                dimension: h.dimension,
+                median_r: h.median_r,
+                median_lag_cycles: h.median_lag_cycles,
+                lag_iqr_cycles: h.lag_iqr_cycles,
+                chance_median_r: h.chance_median_r,
+                excess: h.excess,
+                excess_interval: h.excess_interval,
+                above_chance: h.above_chance,
+            }
+        })
+        .collect())
 }

@@ -70,6 +70,7 @@ pub(super) fn html_report(
     sections.push(accuracy_section(r, accuracy_figs));
     sections.extend(authority_section(r, f.fig5, models));
     sections.extend(controls_section(r));
+    sections.extend(hidden_section(r));
     sections.push(Section {
         heading: "Wing motions".into(),
         figures: vec![Figure {
@@ -101,6 +102,57 @@ pub(super) fn html_report(
         }),
         versions: versions(),
     }
+}
+
+/// Every input's authority on the hidden subspace beyond the outputs, basis-free
+/// ([`flapssm_analysis::hidden`]), beside the paper's rows on single hidden states.
+fn hidden_section(r: &EvaluationReport) -> Option<Section> {
+    let first = r.hidden_authority.first()?;
+    let rows = r
+        .hidden_authority
+        .iter()
+        .map(|h| {
+            vec![
+                h.input.clone(),
+                if h.paper.is_empty() {
+                    "—".into()
+                } else {
+                    h.paper.clone()
+                },
+                f3(h.median_r),
+                f3(h.median_lag_cycles),
+                f3(h.lag_iqr_cycles),
+                f3(h.chance_median_r),
+                format!(
+                    "{:+.3} [{:+.3}, {:+.3}]",
+                    h.excess, h.excess_interval.lo, h.excess_interval.hi
+                ),
+                if h.above_chance { "yes" } else { "no" }.into(),
+            ]
+        })
+        .collect();
+    Some(Section {
+        heading: "Control authority on the hidden subspace".into(),
+        paragraphs: vec![format!(
+            "The states beyond the outputs are defined only up to a change of basis, so the paper's rows on x7, x8, x10 and x12 are restated on the subspace they span ({} dimensions, the part the outputs explain removed): per trajectory the peak over 0 < lag < {} cycle of the multiple correlation R of the input with that subspace (the largest correlation with any combination of hidden states, unchanged by a change of basis), and the same with another trajectory's input, the chance level. An input has authority there when the mean excess of R over chance has a 95 % bootstrap interval above zero.",
+            first.dimension, r.options.authority.max_lag_cycles
+        )],
+        tables: vec![Table {
+            caption: "Each input on the hidden subspace".into(),
+            header: strings(&[
+                "input",
+                "paper (single hidden states)",
+                "median R",
+                "median lag (cycles)",
+                "lag IQR",
+                "chance median R",
+                "excess over chance [95 %]",
+                "above chance",
+            ]),
+            rows,
+        }],
+        figures: Vec::new(),
+    })
 }
 
 /// The Fig. 5 findings on the outputs beside their controls ([`super::controls`]).

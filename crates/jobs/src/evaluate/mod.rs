@@ -45,7 +45,7 @@ pub use html::versions;
 pub use job::{EvaluationModels, evaluate_models};
 pub use report::{
     AuthorityFinding, COEFFICIENT_LABELS, COMPARISON_DRAWS, EVALUATION_FILES, EvalOptions,
-    EvaluationReport, INPUT_LABELS, METRICS_VERSION, ModelMetrics, PairedComparison,
+    EvaluationReport, HiddenFinding, INPUT_LABELS, METRICS_VERSION, ModelMetrics, PairedComparison,
     PredictionTiming, ReportContext, SplitMetrics, TrajectoryMetrics, TrajectoryModelMetrics,
 };
 
@@ -146,7 +146,10 @@ pub fn evaluate(
         &examples,
         &mut file,
     )?;
-    let report_findings = authority.map(|a| a.findings);
+    let (report_findings, hidden_authority) = match authority {
+        Some(a) => (Some(a.findings), a.hidden),
+        None => (None, Vec::new()),
+    };
     let mut report = EvaluationReport {
         version: METRICS_VERSION,
         dataset: dataset_label.to_string(),
@@ -157,6 +160,7 @@ pub fn evaluate(
         rmse_ratio,
         trajectories,
         authority_findings: report_findings.clone().unwrap_or_default(),
+        hidden_authority,
         example_trajectories: examples,
         paper_comparison: Vec::new(),
         prediction_timing: models

@@ -21,7 +21,9 @@
 
 use serde::{Deserialize, Serialize};
 
-use flapssm_analysis::stats::median;
+use flapssm_analysis::stats::{Interval, median};
+
+use crate::sweep::SweepKind;
 
 use super::report::{AuthorityFinding, EvaluationReport};
 pub use super::report::{ComparisonRow, Relation};
@@ -342,9 +344,65 @@ pub struct SelectionPoint {
     pub seeds: usize,
 }
 
+/// One swept value against the reference value (D_x 12, the paper's; the largest training
+/// set), paired by seed: the mean over the seeds both ran of the difference of overall test
+/// RMSE, with its 95 % Student-t interval over those seeds.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SelectionDifference {
+    /// The swept value.
+    pub value: usize,
+    /// The value it is compared with.
+    pub reference: usize,
+    /// Seeds both ran.
+    pub seeds: usize,
+    /// Mean of `RMSE(value) − RMSE(reference)` over those seeds (σ).
+    pub mean: f64,
+    /// Its 95 % interval over seeds (`None` with a single seed).
+    pub interval: Option<Interval>,
+    /// Whether the interval excludes zero.
+    pub significant: bool,
+}
+
+impl std::fmt::Display for SelectionDifference {
+    /// `16 − 12: +0.001 [−0.010, +0.012] (2 seeds)`, `*` when significant.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{} − {}: {:+.3}", self.value, self.reference, self.mean)?;
+        if let Some(i) = self.interval {
+            write!(f, " [{:+.3}, {:+.3}]", i.lo, i.hi)?;
+        }
+        write!(
+            f,
+            " ({} seed{}){}",
+            self.seeds,
+            if self.seeds == 1 { "" } else { "s" },
+            if self.significant { "*" } else { "" }
+        )
+    }
+}
+
 /// The rows of the paper's two selections (line 95) from sweep results: `dx` points for
-/// D_x ∈ {8, 12, 16}, `sizes` points for the training-set size.
-pub fn selection_rows(dx: &[SelectionPoint], sizes: &[SelectionPoint]) -> Vec<ComparisonRow> {
+/// D_x ∈ {8, 12, 16}, `sizes` points for the training-set size, and each value's paired
+/// difference from its reference over seeds.
+pub fn selection_rows(
+    dx: &[SelectionPoint],
+    sizes: &[SelectionPoint],
+    differences: &[(SweepKind, SelectionDifference)],
+) -> Vec<ComparisonRow> {
+    let paired = |kind: SweepKind| {
+        let d: Vec<String> = differences
+            .iter()
+            .filter(|(k, _)| *k == kind)
+            .map(|(_, d)| d.to_string())
+            .collect();
+        if d.is_empty() {
+            String::new()
+        } else {
+            format!(
+                "; paired over seeds, test RMSE difference [95 % t interval]: {}",
+                d.join("; ")
+            )
+        }
+    };
     let mut rows = Vec::new();
     if !dx.is_empty() {
         rows.push(ComparisonRow {
@@ -361,7 +419,8 @@ pub fn selection_rows(dx: &[SelectionPoint], sizes: &[SelectionPoint]) -> Vec<Co
                     )
                 })
                 .collect::<Vec<_>>()
-                .join("; "),
+                .join("; ")
+                + &paired(SweepKind::Dx),
             relation: None,
         });
     }
@@ -380,7 +439,8 @@ pub fn selection_rows(dx: &[SelectionPoint], sizes: &[SelectionPoint]) -> Vec<Co
                     )
                 })
                 .collect::<Vec<_>>()
-                .join("; "),
+                .join("; ")
+                + &paired(SweepKind::DataSize),
             relation: None,
         });
     }

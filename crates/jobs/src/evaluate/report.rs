@@ -219,6 +219,33 @@ pub struct AuthorityFinding {
     pub strong: bool,
 }
 
+/// The authority of one input on the hidden subspace beyond the outputs
+/// ([`flapssm_analysis::hidden`]): the paper's latent rows (x7, x8, x10, x12) in a form no
+/// change of basis alters.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct HiddenFinding {
+    /// Input name.
+    pub input: String,
+    /// What the paper says of this input on single hidden states (empty where nothing).
+    pub paper: String,
+    /// The subspace's dimension (D_x − 5 where no direction is numerically absent).
+    pub dimension: usize,
+    /// Median over trajectories of the peak multiple correlation R.
+    pub median_r: f64,
+    /// Median lag of the peak (cycles).
+    pub median_lag_cycles: f64,
+    /// Interquartile range of the lag (cycles).
+    pub lag_iqr_cycles: f64,
+    /// Median R with another trajectory's input: the chance level.
+    pub chance_median_r: f64,
+    /// Mean excess of R over chance, with its 95 % bootstrap interval over trajectories.
+    pub excess: f64,
+    /// See `excess`.
+    pub excess_interval: Interval,
+    /// Whether the interval lies above zero.
+    pub above_chance: bool,
+}
+
 /// Everything [`evaluate`](super::evaluate) computes (written as `metrics.json`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct EvaluationReport {
@@ -243,6 +270,10 @@ pub struct EvaluationReport {
     /// a_x, dα/dt and d²α/dt² on the output states x1..x5, d²α/dt² and dα/dt on x7, a_y on
     /// x8, x10 and x12 (those within D_x); empty without a latent-state model.
     pub authority_findings: Vec<AuthorityFinding>,
+    /// Every input's authority on the hidden subspace of that model (D_x > 5), with its chance
+    /// level; empty otherwise.
+    #[serde(default)]
+    pub hidden_authority: Vec<HiddenFinding>,
     /// The Fig. 3 example trajectories (dataset indices): on the paper's own trajectories the
     /// paper's six, else test trajectories of distinct families.
     #[serde(default)]

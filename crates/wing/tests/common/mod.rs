@@ -88,3 +88,15 @@ pub fn mirrored(states: &[EulerState]) -> Vec<EulerState> {
         })
         .collect()
 }
+
+/// Asserts that a study's figures `got` lie within `tol` of the values it printed when its
+/// output was recorded (docs/lab/wing-studies.md), naming the figure.
+pub fn assert_recorded(what: &str, got: &[f64], recorded: &[f64], tol: f64) {
+    assert_eq!(got.len(), recorded.len(), "{what}: {got:?}");
+    for (k, (g, r)) in got.iter().zip(recorded).enumerate() {
+        assert!(
+            (g - r).abs() <= tol,
+            "{what}[{k}]: {g:.4}, recorded {r} (tolerance {tol}); all: {got:.4?}"
+        );
+    }
+}
