@@ -27,21 +27,10 @@ use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::authority::AuthorityConfig;
+use crate::authority::{AuthorityConfig, AuthorityTrajectory};
 use crate::error::{AnalysisError, Result, param};
 use crate::stats::{Interval, Rows, central_interval, median, quartiles};
 use crate::xcorr::{peak_within_cycle, standardize_into, xcf_positive_into};
-
-/// One trajectory's series.
-#[derive(Debug, Clone, Copy)]
-pub struct HiddenTrajectory<'a> {
-    /// Inputs, `n_time × n_input`.
-    pub inputs: Rows<'a>,
-    /// Latent means, `n_time × n_state`; the first `n_output` columns are the outputs.
-    pub states: Rows<'a>,
-    /// Stroke period in samples.
-    pub period_samples: f64,
-}
 
 /// One input's authority on the hidden subspace.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -122,14 +111,15 @@ fn peak(
 }
 
 /// The authority of every input on the hidden subspace of states `n_output..` (module docs),
-/// with its chance level; bootstrap from `seed`.
+/// with its chance level; bootstrap from `seed`. The trajectories are those of the published
+/// analysis ([`AuthorityTrajectory`]: inputs, latent means, stroke period).
 ///
 /// # Errors
 /// [`AnalysisError::Empty`] for no trajectory, [`AnalysisError::Shape`] for tables of other
 /// widths or lengths, a parameter error for a bad config or period, or `n_output` not below the
 /// states; [`AnalysisError::ConstantSeries`] naming a constant input.
 pub fn hidden_authority(
-    trajectories: &[HiddenTrajectory<'_>],
+    trajectories: &[AuthorityTrajectory<'_>],
     n_output: usize,
     config: &AuthorityConfig,
     seed: u64,
@@ -276,7 +266,12 @@ mod tests {
     /// Smooth noise: a sum of a few random-phase sines of periods 20–200 samples.
     fn smooth(t_len: usize, rng: &mut ChaCha8Rng) -> Vec<f64> {
         let comps: Vec<(f64, f64)> = (0..6)
-            .map(|_| (rng.random_range(20.0..200.0), rng.random_range(0.0..std::f64::consts::TAU)))
+            .map(|_| {
+                (
+                    rng.random_range(20.0..200.0),
+                    rng.random_range(0.0..std::f64::consts::TAU),
+                )
+            })
             .collect();
         (0..t_len)
             .map(|t| {
@@ -323,10 +318,10 @@ mod tests {
 
     fn run(mix: [[f64; 3]; 3], leak: f64) -> Vec<HiddenAuthority> {
         let (inputs, states) = dataset(mix, leak);
-        let trs: Vec<HiddenTrajectory<'_>> = inputs
+        let trs: Vec<AuthorityTrajectory<'_>> = inputs
             .iter()
             .zip(&states)
-            .map(|(u, x)| HiddenTrajectory {
+            .map(|(u, x)| AuthorityTrajectory {
                 inputs: Rows::new(u, 2).unwrap(),
                 states: Rows::new(x, 5).unwrap(),
                 period_samples: 100.0,
@@ -371,14 +366,14 @@ mod tests {
     fn bad_shapes_are_refused() {
         let u = vec![0.0; 20];
         let x = vec![0.0; 30];
-        let tr = [HiddenTrajectory {
+        let tr = [AuthorityTrajectory {
             inputs: Rows::new(&u, 2).unwrap(),
             states: Rows::new(&x, 3).unwrap(),
             period_samples: 5.0,
         }];
         assert!(hidden_authority(&tr, 1, &AuthorityConfig::default(), 0).is_err());
         let x = vec![0.0; 20];
-        let tr = [HiddenTrajectory {
+        let tr = [AuthorityTrajectory {
             inputs: Rows::new(&u, 2).unwrap(),
             states: Rows::new(&x, 2).unwrap(),
             period_samples: 5.0,

@@ -1,4 +1,4 @@
-//! `flapssm rig check / fit-mount / wang2004`: their files, and bad input refused by name
+//! `flapssm rig check / fit-mount / wang2004 / draws / recovery`: their files, and bad input refused by name
 //! with nothing written.
 
 mod common;
@@ -126,4 +126,79 @@ fn wang2004_compares_the_published_histories() {
     let bad = dir.path().join("bad");
     let o = flapssm(&["rig", "wang2004", "--data", s(&empty), "--out", s(&bad)]);
     assert_fails(&o, &["CL_EXP.dat"], &bad.join("wang2004.json"));
+}
+
+/// `rig draws` writes the paper's 548 trajectories with drawn loads, the same file for the same
+/// seed; `rig recovery` refuses draws that are not those 548 trajectories, and a missing model,
+/// by name, with nothing written.
+#[test]
+fn draws_are_reproducible_and_recovery_refuses_other_data() {
+    let dir = tempfile::tempdir().unwrap();
+    let draws = |name: &str, seed: &str| {
+        let path = dir.path().join(name);
+        let text = ok(&[
+            "rig",
+            "draws",
+            "--reference",
+            &published(),
+            "--seed",
+            seed,
+            "--out",
+            s(&path),
+            "--quiet",
+        ]);
+        assert!(
+            text.contains("548 measured trajectories (512 train)"),
+            "{text}"
+        );
+        std::fs::read(&path).unwrap()
+    };
+    let (a, b, c) = (
+        draws("a.npz", "1"),
+        draws("b.npz", "1"),
+        draws("c.npz", "2"),
+    );
+    assert!(a == b, "same seed, same file");
+    assert!(a != c, "another seed, other draws");
+
+    let paper8 = dir.path().join("paper8.npz");
+    ok(&[
+        "simulate",
+        "--source",
+        "paper",
+        "--n",
+        "8",
+        "--noise-free",
+        "--quiet",
+        "--out",
+        s(&paper8),
+    ]);
+    let model = dir.path().join("published.json");
+    ok(&[
+        "model",
+        "import-published",
+        &published(),
+        "--out",
+        s(&model),
+    ]);
+    let out = dir.path().join("recovery");
+    let recovery = |dataset: &str, prssm: &str| {
+        flapssm(&[
+            "rig",
+            "recovery",
+            dataset,
+            "--prssm",
+            prssm,
+            "--reference",
+            &published(),
+            "--out",
+            s(&out),
+            "--quiet",
+        ])
+    };
+    let o = recovery(s(&paper8), s(&model));
+    assert_fails(&o, &["548", "rig draws"], &out.join("recovery.json"));
+    let missing = dir.path().join("missing.json");
+    let o = recovery(s(&dir.path().join("a.npz")), s(&missing));
+    assert_fails(&o, &["missing.json"], &out.join("recovery.json"));
 }

@@ -60,6 +60,14 @@ fn prssm_minus_gp_static(fidelity: Fidelity) -> Vec<(f64, bool)> {
         &NoProgress,
     )
     .unwrap();
+    // D_x 12: the paper's latent rows restated on the 7-dimensional hidden subspace.
+    assert_eq!(report.hidden_authority.len(), 7);
+    assert!(
+        report
+            .hidden_authority
+            .iter()
+            .all(|h| h.subspace.dimension == 7)
+    );
     let c = &report.comparisons[0];
     assert_eq!(
         (c.a.as_str(), c.b.as_str(), c.split.as_str()),

@@ -242,6 +242,8 @@ def test_evaluate_returns_the_metrics(small, tmp_path):
     assert findings and {f["input"] for f in findings} <= labels
     assert {f["state"] for f in findings} <= {f"x{i}" for i in range(1, 6)}
     assert all(0.0 <= f["median_abs_r"] <= 1.0 for f in findings)
+    # D_x 5: every state is an output, so there is no hidden subspace to analyse.
+    assert report["hidden_authority"] == []
     # The paper beside this evaluation, each row with its source in the paper.
     rows = report["paper_comparison"]
     assert any(r["endpoint"].startswith("C_Fx RMSE, PR-SSM") for r in rows)

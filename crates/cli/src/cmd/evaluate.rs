@@ -172,15 +172,19 @@ pub fn run(a: EvaluateArgs) -> anyhow::Result<()> {
     for h in &r.hidden_authority {
         println!(
             "hidden subspace ({} dims) ← {}: R {:.2} lag {:.3} (chance {:.2}), excess {:+.3} [{:+.3}, {:+.3}]{}",
-            h.dimension,
+            h.subspace.dimension,
             h.input,
-            h.median_r,
-            h.median_lag_cycles,
-            h.chance_median_r,
-            h.excess,
-            h.excess_interval.lo,
-            h.excess_interval.hi,
-            if h.above_chance { " above chance" } else { "" }
+            h.subspace.median_r,
+            h.subspace.median_lag_cycles,
+            h.subspace.chance_median_r,
+            h.subspace.excess,
+            h.subspace.excess_interval.lo,
+            h.subspace.excess_interval.hi,
+            if h.subspace.above_chance {
+                " above chance"
+            } else {
+                ""
+            }
         );
     }
     println!(

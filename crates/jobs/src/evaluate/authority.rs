@@ -4,7 +4,7 @@
 use std::path::Path;
 
 use flapssm_analysis::authority::{AuthoritySummary, AuthorityTrajectory, PeakTable, peak_table};
-use flapssm_analysis::hidden::{HiddenTrajectory, hidden_authority};
+use flapssm_analysis::hidden::hidden_authority;
 use flapssm_wing::dataset::ValidDataset;
 
 use super::paper::{FIG5_CLAIMS, fig5_pairs};
@@ -114,15 +114,7 @@ fn hidden_findings(
     trajectories: &[AuthorityTrajectory<'_>],
     opts: &EvalOptions,
 ) -> Result<Vec<HiddenFinding>> {
-    let trajectories: Vec<HiddenTrajectory<'_>> = trajectories
-        .iter()
-        .map(|t| HiddenTrajectory {
-            inputs: t.inputs,
-            states: t.states,
-            period_samples: t.period_samples,
-        })
-        .collect();
-    let found = hidden_authority(&trajectories, N_OUTPUT, &opts.authority, opts.seed)
+    let found = hidden_authority(trajectories, N_OUTPUT, &opts.authority, opts.seed)
         .map_err(analysis("authority on the hidden subspace"))?;
     Ok(found
         .into_iter()
@@ -142,14 +134,7 @@ fn hidden_findings(
             HiddenFinding {
                 input: input.to_string(),
                 paper,
-                dimension: h.dimension,
-                median_r: h.median_r,
-                median_lag_cycles: h.median_lag_cycles,
-                lag_iqr_cycles: h.lag_iqr_cycles,
-                chance_median_r: h.chance_median_r,
-                excess: h.excess,
-                excess_interval: h.excess_interval,
-                above_chance: h.above_chance,
+                subspace: h,
             }
         })
         .collect())

@@ -119,15 +119,15 @@ fn hidden_section(r: &EvaluationReport) -> Option<Section> {
                 } else {
                     h.paper.clone()
                 },
-                f3(h.median_r),
-                f3(h.median_lag_cycles),
-                f3(h.lag_iqr_cycles),
-                f3(h.chance_median_r),
+                f3(h.subspace.median_r),
+                f3(h.subspace.median_lag_cycles),
+                f3(h.subspace.lag_iqr_cycles),
+                f3(h.subspace.chance_median_r),
                 format!(
                     "{:+.3} [{:+.3}, {:+.3}]",
-                    h.excess, h.excess_interval.lo, h.excess_interval.hi
+                    h.subspace.excess, h.subspace.excess_interval.lo, h.subspace.excess_interval.hi
                 ),
-                if h.above_chance { "yes" } else { "no" }.into(),
+                if h.subspace.above_chance { "yes" } else { "no" }.into(),
             ]
         })
         .collect();
@@ -135,7 +135,7 @@ fn hidden_section(r: &EvaluationReport) -> Option<Section> {
         heading: "Control authority on the hidden subspace".into(),
         paragraphs: vec![format!(
             "The states beyond the outputs are defined only up to a change of basis, so the paper's rows on x7, x8, x10 and x12 are restated on the subspace they span ({} dimensions, the part the outputs explain removed): per trajectory the peak over 0 < lag < {} cycle of the multiple correlation R of the input with that subspace (the largest correlation with any combination of hidden states, unchanged by a change of basis), and the same with another trajectory's input, the chance level. An input has authority there when the mean excess of R over chance has a 95 % bootstrap interval above zero.",
-            first.dimension, r.options.authority.max_lag_cycles
+            first.subspace.dimension, r.options.authority.max_lag_cycles
         )],
         tables: vec![Table {
             caption: "Each input on the hidden subspace".into(),

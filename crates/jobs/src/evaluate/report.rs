@@ -7,6 +7,7 @@ use super::controls::{AuthorityControl, ControlLags};
 use serde::{Deserialize, Serialize};
 
 use flapssm_analysis::authority::AuthorityConfig;
+use flapssm_analysis::hidden::HiddenAuthority;
 use flapssm_analysis::metrics::PUBLISHED_START_SAMPLE;
 use flapssm_analysis::stats::Interval;
 
@@ -228,22 +229,8 @@ pub struct HiddenFinding {
     pub input: String,
     /// What the paper says of this input on single hidden states (empty where nothing).
     pub paper: String,
-    /// The subspace's dimension (D_x − 5 where no direction is numerically absent).
-    pub dimension: usize,
-    /// Median over trajectories of the peak multiple correlation R.
-    pub median_r: f64,
-    /// Median lag of the peak (cycles).
-    pub median_lag_cycles: f64,
-    /// Interquartile range of the lag (cycles).
-    pub lag_iqr_cycles: f64,
-    /// Median R with another trajectory's input: the chance level.
-    pub chance_median_r: f64,
-    /// Mean excess of R over chance, with its 95 % bootstrap interval over trajectories.
-    pub excess: f64,
-    /// See `excess`.
-    pub excess_interval: Interval,
-    /// Whether the interval lies above zero.
-    pub above_chance: bool,
+    /// The figures: median R and lag, the chance level, the excess over chance.
+    pub subspace: HiddenAuthority,
 }
 
 /// Everything [`evaluate`](super::evaluate) computes (written as `metrics.json`).
