@@ -11,7 +11,10 @@
 //!
 //! The paired 95 % bootstrap over the test trajectories decides "significantly". A PR-SSM that
 //! learns no memory fails the positive control; a comparison that credits the PR-SSM with
-//! memory it cannot have fails the negative one. The same runs from the command line:
+//! memory it cannot have fails the negative one. At the paper's scale it does: trained on 512
+//! trajectories the PR-SSM beats GP-static on L0 too (docs/results.md, "The PR-SSM against the
+//! static baseline where the memory is known"), so these tests hold the comparison at a size
+//! where the PR-SSM is not yet the better static regressor. The same runs from the command line:
 //! `flapssm simulate --fidelity l0 --noise-free --flat --n 64 --n-train 48 --seed 3`, `flapssm
 //! train --preset paper-fast --epochs 100 --seed 1`, `flapssm evaluate --baseline gp-static`.
 
