@@ -92,6 +92,50 @@ pub struct AuthorityTrajectory<'a> {
     pub period_samples: f64,
 }
 
+impl AuthorityTrajectory<'_> {
+    /// Checks trajectory `i`: `n_input` inputs and `n_state` states over the same samples
+    /// (`n_time` of them, when given) and a finite positive period.
+    ///
+    /// # Errors
+    /// [`AnalysisError::Shape`] naming the trajectory, [`AnalysisError::Parameter`] for its
+    /// period.
+    pub fn check(
+        &self,
+        i: usize,
+        n_input: usize,
+        n_state: usize,
+        n_time: Option<usize>,
+    ) -> Result<()> {
+        let t_len = n_time.unwrap_or(self.inputs.n_rows());
+        if self.inputs.n_rows() != t_len
+            || self.states.n_rows() != t_len
+            || self.inputs.n_cols() != n_input
+            || self.states.n_cols() != n_state
+        {
+            let rows = n_time.map_or("n_time".to_string(), |t| t.to_string());
+            return Err(AnalysisError::Shape {
+                what: format!("trajectory {i} inputs/states"),
+                expected: format!("{rows} × {n_input} inputs and {rows} × {n_state} states"),
+                found: format!(
+                    "{} × {} inputs, {} × {} states",
+                    self.inputs.n_rows(),
+                    self.inputs.n_cols(),
+                    self.states.n_rows(),
+                    self.states.n_cols()
+                ),
+            });
+        }
+        if !(self.period_samples.is_finite() && self.period_samples > 0.0) {
+            return Err(param(
+                &format!("trajectory {i} period_samples"),
+                self.period_samples,
+                "must be finite and > 0",
+            ));
+        }
+        Ok(())
+    }
+}
+
 /// Peak cross-correlations, indexed `[trajectory][state][input]`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct PeakTable {
@@ -179,29 +223,7 @@ pub fn peak_table(
     let (n_state, n_input) = (first.states.n_cols(), first.inputs.n_cols());
     let one = |(i, tr): (usize, &AuthorityTrajectory<'_>)| -> Result<Vec<Option<PeakCorrelation>>> {
         let t_len = tr.inputs.n_rows();
-        if tr.states.n_rows() != t_len
-            || tr.states.n_cols() != n_state
-            || tr.inputs.n_cols() != n_input
-        {
-            return Err(AnalysisError::Shape {
-                what: format!("trajectory {i} inputs/states"),
-                expected: format!("n_time × {n_input} inputs and n_time × {n_state} states"),
-                found: format!(
-                    "{} × {} inputs, {} × {} states",
-                    t_len,
-                    tr.inputs.n_cols(),
-                    tr.states.n_rows(),
-                    tr.states.n_cols()
-                ),
-            });
-        }
-        if !(tr.period_samples.is_finite() && tr.period_samples > 0.0) {
-            return Err(param(
-                &format!("trajectory {i} period_samples"),
-                tr.period_samples,
-                "must be finite and > 0",
-            ));
-        }
+        tr.check(i, n_input, n_state, None)?;
         let std_cols = |tab: Rows<'_>, kind: &str| -> Result<Vec<f64>> {
             let mut z = vec![0.0; tab.n_rows() * tab.n_cols()];
             for (c, zc) in z.chunks_exact_mut(t_len).enumerate() {

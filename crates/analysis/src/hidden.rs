@@ -141,30 +141,7 @@ pub fn hidden_authority(
         ));
     }
     for (i, tr) in trajectories.iter().enumerate() {
-        if tr.inputs.n_rows() != t_len
-            || tr.states.n_rows() != t_len
-            || tr.inputs.n_cols() != n_input
-            || tr.states.n_cols() != n_state
-        {
-            return Err(AnalysisError::Shape {
-                what: format!("trajectory {i} inputs/states"),
-                expected: format!("{t_len} × {n_input} inputs and {t_len} × {n_state} states"),
-                found: format!(
-                    "{} × {} inputs, {} × {} states",
-                    tr.inputs.n_rows(),
-                    tr.inputs.n_cols(),
-                    tr.states.n_rows(),
-                    tr.states.n_cols()
-                ),
-            });
-        }
-        if !(tr.period_samples.is_finite() && tr.period_samples > 0.0) {
-            return Err(param(
-                &format!("trajectory {i} period_samples"),
-                tr.period_samples,
-                "must be finite and > 0",
-            ));
-        }
+        tr.check(i, n_input, n_state, Some(t_len))?;
     }
     let n_traj = trajectories.len();
     let standardized: Vec<Vec<Vec<f64>>> = trajectories
