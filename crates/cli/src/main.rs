@@ -46,6 +46,9 @@ enum Command {
     /// The rig as the judge: a dataset of the paper's trajectories against the published model's
     /// prediction of the rig's loads; the mount angles that bring a wing closest to it.
     Rig(cmd::rig::RigArgs),
+    /// Wing kinematics chosen with a learned model, verified on the virtual wing; cycle-to-cycle
+    /// control of the mean lift.
+    Design(cmd::design::DesignArgs),
     /// Evaluate a PR-SSM and an LRQSM on a dataset: metrics, authority, figures, report.
     Evaluate(cmd::evaluate::EvaluateArgs),
     /// The history curve: a GP baseline's test error against the input history it is given.
@@ -97,6 +100,7 @@ fn run(command: Command) -> anyhow::Result<()> {
         Command::Simulate(args) => cmd::simulate::run(args),
         Command::Qs { command } => cmd::qs::run(command),
         Command::Rig(args) => cmd::rig::run(args),
+        Command::Design(args) => cmd::design::run(args),
         Command::Evaluate(args) => cmd::evaluate::run(args),
         Command::History(args) => cmd::history::run(args),
         Command::Sweep { command } => cmd::sweep::run(command),

@@ -58,6 +58,9 @@ pub enum JobError {
         /// Cause.
         source: FitError,
     },
+    /// A design's target or settings were refused (naming the field), or its model failed.
+    #[error("design: {0}")]
+    Design(#[from] flapssm_design::DesignError),
     /// The simulator failed.
     #[error("simulation: {0}")]
     Simulate(#[from] flapssm_wing::virtual_wing::SimulateError),

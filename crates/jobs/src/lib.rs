@@ -18,6 +18,7 @@
 //! | [`own_rig`] | a user's rig: its description, raw recordings into a dataset, the virtual wing rehearsing it |
 //! | [`sweep`] | one-configuration PR-SSM sweep runs (D_x, training-set size) and their merge |
 //! | [`demo`] | the one-command demo: simulate, fit, train, evaluate (resumable) |
+//! | [`design`] | kinematics chosen with a load model and verified on the wing; hover at least power; the closed loop |
 //! | [`bench`](mod@bench) | the engine's speed in the paper's configuration beside the authors' code |
 //! | [`curve`] | learning curves with wall times, and the time-to-quality read from them |
 //! | [`wang2004`] | the published 2-D hovering experiment (Wang, Birch & Dickinson 2004) beside every fidelity |
@@ -35,6 +36,7 @@ pub mod adapters;
 pub mod bench;
 pub mod curve;
 pub mod demo;
+pub mod design;
 pub mod error;
 pub mod evaluate;
 pub mod files;

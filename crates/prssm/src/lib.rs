@@ -30,6 +30,9 @@
 //!   ([`PrssmModel::save`], [`PrssmModel::load`]); [`published::import_published`]; prediction
 //!   in physical units from the model's initial-state rule ([`PrssmModel::predict_sequence`],
 //!   over [`predict::predict_standardized`]; [`Normalization::of_sequences`] for the statistics).
+//! - [`sensitivity::InputSensitivity`]: the open-loop prediction and the exact gradient of any
+//!   scalar of its output moments with respect to the inputs (reverse mode through the
+//!   particles with their draws held fixed), for choosing inputs with the model.
 //! - [`regression`]: sparse GP regression of a static map with the same kernels and k-means
 //!   inducing inputs (the static nonlinear baseline's engine).
 #![warn(missing_docs)]
@@ -49,6 +52,7 @@ pub mod precision;
 pub mod predict;
 pub mod published;
 pub mod regression;
+pub mod sensitivity;
 pub mod step;
 pub mod stream;
 mod tape;

@@ -93,7 +93,7 @@ pub fn predict_standardized(
 
 /// Particle mean and variance (divided by `P`) of `x` (`P × D_x`) at step `t`, plus the
 /// noise variances. The sums over particles run in particle order for all dims at once.
-fn moments<T: StepFloat>(
+pub(crate) fn moments<T: StepFloat>(
     x: &[T],
     dx: usize,
     dy: usize,
@@ -204,7 +204,7 @@ pub fn simulate_with_draws(
     Ok((all, pred))
 }
 
-fn empty_prediction(t_n: usize, dx: usize, dy: usize) -> Prediction {
+pub(crate) fn empty_prediction(t_n: usize, dx: usize, dy: usize) -> Prediction {
     Prediction {
         output_mean: vec![0.0; t_n * dy],
         output_var: vec![0.0; t_n * dy],

@@ -3,6 +3,7 @@
 //! (`flapssm-jobs`); errors become Python exceptions carrying the CLI's messages.
 
 mod dataset;
+mod design;
 mod errors;
 mod evaluate;
 mod lrqsm;
@@ -34,6 +35,8 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(evaluate::evaluate, m)?)?;
     m.add_function(wrap_pyfunction!(evaluate::history_curve, m)?)?;
     m.add_function(wrap_pyfunction!(rig::rig_check, m)?)?;
+    m.add_function(wrap_pyfunction!(design::design_target, m)?)?;
+    m.add_function(wrap_pyfunction!(design::design_control, m)?)?;
     m.add_function(wrap_pyfunction!(own_rig::rig_template, m)?)?;
     m.add_function(wrap_pyfunction!(own_rig::load_rig_description, m)?)?;
     m.add_function(wrap_pyfunction!(own_rig::build_dataset, m)?)?;

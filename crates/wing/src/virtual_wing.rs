@@ -447,6 +447,22 @@ impl VirtualWing {
         errors: &DatasetSensorErrors,
         rng: &mut ChaCha8Rng,
     ) -> Result<Trajectory, SimulateError> {
+        let outputs = self.measure_states(states, sampling, index, errors, rng)?;
+        self.trajectory_of(states, family, sampling, index, outputs)
+    }
+
+    /// The sensor's loads `[F_x, F_y, M_x, M_y, M_z]` (N, N·mm) at the dataset rate
+    /// (`n_samples` of them) for raw-rate states: the aerodynamics at the plate's mount, the
+    /// plate's static and inertial residuals, the sensor chain, decimation. Errors name
+    /// trajectory `index`.
+    pub fn measure_states(
+        &mut self,
+        states: &[EulerState],
+        sampling: &crate::trajectories::SamplingConfig,
+        index: usize,
+        errors: &DatasetSensorErrors,
+        rng: &mut ChaCha8Rng,
+    ) -> Result<Vec<[f64; 5]>, SimulateError> {
         let mount = self.cfg.mount;
         let plate_states: std::borrow::Cow<[EulerState]> = if mount.plate_aligned() {
             states.into()
@@ -489,6 +505,19 @@ impl VirtualWing {
             rng,
         );
         outputs.truncate(sampling.n_samples);
+        Ok(outputs)
+    }
+
+    /// The trajectory of raw-rate `states` and their measured `outputs`: the encoder's and
+    /// differentiator's states, decimated, their inputs and U_ref.
+    fn trajectory_of(
+        &self,
+        states: &[EulerState],
+        family: &str,
+        sampling: &crate::trajectories::SamplingConfig,
+        index: usize,
+        outputs: Vec<[f64; 5]>,
+    ) -> Result<Trajectory, SimulateError> {
         let measured = if self.cfg.sensor.encoder {
             use crate::differentiate::{SavitzkyGolay, SavitzkyGolayConfig, quantize_to_encoder};
             let counts = self.cfg.sensor.encoder_counts_per_rev;

@@ -10,6 +10,7 @@
 //! | [`errors`] | Fig. 4: standardized-error histograms with intervals; half-stroke averages |
 //! | [`authority`] | Fig. 5: HDR contours and modes, per-pair scatter, summary circle grid |
 //! | [`hovering`] | the published hovering case: C_L and C_D histories of several sources |
+//! | [`design`] | designed kinematics, their loads with the predicted band, convergence, a closed loop |
 //! | [`rig`] | the rig check: a dataset's standardized loads over the reference's mean and 95 % band |
 //! | [`wing3d`] | Fig. 2C: 3-D wing-motion sketches (chord lines along the path, LE dotted) |
 //! | [`training`] | training curves |
@@ -25,6 +26,7 @@ use plotters::style::{FontStyle, register_font};
 use crate::error::{AnalysisError, Result};
 
 pub mod authority;
+pub mod design;
 pub mod errors;
 pub mod history;
 pub mod hovering;

@@ -4,6 +4,7 @@ pub mod bench;
 pub mod choices;
 pub mod dataset;
 pub mod demo;
+pub mod design;
 pub mod evaluate;
 pub mod history;
 pub mod model;

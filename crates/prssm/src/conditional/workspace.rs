@@ -292,22 +292,40 @@ impl ConditionalWorkspace {
         xbar: &mut [f64],
     ) {
         let mut tape = std::mem::take(&mut self.tape);
-        self.backward_tape(post, n, &mut tape, mean_bar, var_bar, grads, xbar);
+        let adjoints = (mean_bar, var_bar);
+        self.backward_tape(post, n, &mut tape, adjoints, grads, (xbar, post.dx));
+        self.tape = tape;
+    }
+
+    /// [`Self::backward`] that adds `∂loss/∂[x; u]` of all `D = D_x + D_u` GP inputs into
+    /// `xbar` (`D × N`, the layout of [`Self::input`]): the sensitivity of the conditional to
+    /// its inputs as well as its states. Allocates nothing.
+    pub fn backward_all_inputs(
+        &mut self,
+        post: &Posterior,
+        n: usize,
+        mean_bar: &[f64],
+        var_bar: &[f64],
+        grads: &mut ConditionalGrads,
+        xbar: &mut [f64],
+    ) {
+        let mut tape = std::mem::take(&mut self.tape);
+        let adjoints = (mean_bar, var_bar);
+        self.backward_tape(post, n, &mut tape, adjoints, grads, (xbar, post.d));
         self.tape = tape;
     }
 
     /// [`Self::backward`] from the intermediates a [`Self::forward_tape`] stored in `tape`
-    /// (the formulas of the module doc).
-    #[allow(clippy::too_many_arguments)]
+    /// (the formulas of the module doc); the adjoints of the first `rows` GP inputs (`D_x`:
+    /// the states; `D`: states and inputs) are added into `xbar` (`rows × N`).
     pub(crate) fn backward_tape(
         &mut self,
         post: &Posterior,
         n: usize,
         tape: &mut [f64],
-        mean_bar: &[f64],
-        var_bar: &[f64],
+        (mean_bar, var_bar): (&[f64], &[f64]),
         grads: &mut ConditionalGrads,
-        xbar: &mut [f64],
+        (xbar, rows): (&mut [f64], usize),
     ) {
         let (m, dx) = (post.m, post.dx);
         let r = m + dx;
@@ -507,9 +525,9 @@ impl ConditionalWorkspace {
             &post.zt,
             t.xs,
             &post.inv_len,
-            dx,
+            rows,
             &mut grads.zbar_t,
-            &mut xbar[..dx * n],
+            &mut xbar[..rows * n],
             &mut grads.len_acc,
             &mut self.cx,
             &mut self.zc[..post.d * n],

@@ -375,10 +375,9 @@ impl<'a> Chunk<'a> {
                     self.post,
                     na,
                     &mut tape[slot..slot + tape_step],
-                    &mean_bar[..dx * na],
-                    &var_bar[..dx * na],
+                    (&mean_bar[..dx * na], &var_bar[..dx * na]),
                     &mut adj.cond,
-                    &mut adj.xbar,
+                    (&mut adj.xbar, dx),
                 );
             }
             self.likelihood(

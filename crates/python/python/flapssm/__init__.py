@@ -50,6 +50,10 @@ __all__ = [
     "load_rig",
     "build_dataset",
     "rehearse_rig",
+    "STROKE_QUANTITIES",
+    "design_target",
+    "design_hover",
+    "design_control",
     "LRQSMRegressor",
     "PRSSMRegressor",
 ]
@@ -382,6 +386,108 @@ def rig_check(
     text = _native.rig_check(
         dataset, os.fspath(reference), None if out is None else os.fspath(out),
         int(particles), int(seed), bool(lags), progress,
+    )
+    return json.loads(text)
+
+
+STROKE_QUANTITIES = (
+    "thrust_n", "lift_n", "side_force_n", "roll_moment_n_mm", "yaw_moment_n_mm",
+    "pitch_moment_n_mm", "power_w",
+)
+"""The stroke-frame quantities of a design, in order (docs/design.md has the frame)."""
+
+_DESIGN_DEFAULTS = dict(
+    harmonics=3, particles=16, starts=4, iterations=150, learning_rate=0.01,
+    robust_weight=0.5, seed=0,
+)
+
+
+def _design_knobs(kwargs: dict) -> dict:
+    unknown = set(kwargs) - set(_DESIGN_DEFAULTS)
+    if unknown:
+        raise TypeError(f"unknown design settings: {sorted(unknown)}; known: {sorted(_DESIGN_DEFAULTS)}")
+    knobs = dict(_DESIGN_DEFAULTS)
+    knobs.update(kwargs)
+    return knobs
+
+
+def design_target(
+    prssm: PathLike,
+    targets: dict,
+    lrqsm: Optional[PathLike] = None,
+    frequency_hz: Optional[float] = None,
+    power_weight: float = 0.0,
+    out: Optional[PathLike] = None,
+    progress: Optional[Progress] = None,
+    **settings,
+) -> dict:
+    """Kinematics whose cycle-mean stroke-frame loads meet ``targets`` (``flapssm design
+    target``): a dict over the first six of :data:`STROKE_QUANTITIES` (N, N·mm), the others
+    free, optionally at least power (``power_weight``). Designed with the PR-SSM file
+    ``prssm``, the LRQSM file ``lrqsm`` when given and the quasi-steady wing, each verified on
+    the default virtual wing. ``settings``: harmonics, particles, starts, iterations,
+    learning_rate, robust_weight, seed. With ``out``, writes ``design.json`` and
+    ``design.md``. Returns the report as a dict; a bad target raises ``ValueError`` naming
+    it."""
+    names = STROKE_QUANTITIES[:6]
+    unknown = set(targets) - set(names)
+    if unknown:
+        raise ValueError(f"target: unknown quantities {sorted(unknown)}; known: {list(names)}")
+    values = [None if targets.get(n) is None else float(targets[n]) for n in names]
+    k = _design_knobs(settings)
+    text = _native.design_target(
+        os.fspath(prssm), values, None if lrqsm is None else os.fspath(lrqsm), frequency_hz,
+        float(power_weight), None if out is None else os.fspath(out), k["harmonics"],
+        k["particles"], k["starts"], k["iterations"], k["learning_rate"], k["robust_weight"],
+        k["seed"], progress,
+    )
+    return json.loads(text)
+
+
+def design_hover(
+    prssm: PathLike,
+    weight_n: float,
+    lrqsm: Optional[PathLike] = None,
+    frequency_hz: Optional[float] = None,
+    power_weight: float = 0.05,
+    out: Optional[PathLike] = None,
+    progress: Optional[Progress] = None,
+    **settings,
+) -> dict:
+    """Hover (``flapssm design hover``): mean lift equal to ``weight_n`` (N, carried by this
+    wing), zero mean thrust and pitch moment, at least aerodynamic power; as
+    :func:`design_target`."""
+    weight = float(weight_n)
+    if not (weight > 0 and weight != float("inf")):
+        raise ValueError(f"setting weight_n = {weight_n}: finite and > 0 (N)")
+    targets = {"lift_n": weight, "thrust_n": 0.0, "pitch_moment_n_mm": 0.0}
+    return design_target(
+        prssm, targets, lrqsm=lrqsm, frequency_hz=frequency_hz, power_weight=power_weight,
+        out=out, progress=progress, **settings,
+    )
+
+
+def design_control(
+    prssm: PathLike,
+    lift_n: float,
+    density_factor: float = 1.2,
+    bias_fx_n: float = 0.0,
+    cycles: int = 12,
+    frequency_hz: Optional[float] = None,
+    out: Optional[PathLike] = None,
+    particles: int = 16,
+    seed: int = 0,
+    progress: Optional[Progress] = None,
+) -> dict:
+    """The closed loop (``flapssm design control``): a hover design for ``lift_n`` flown on
+    the default wing in a fluid ``density_factor`` times as dense and with ``bias_fx_n`` (N)
+    on its F_x channel — a mismatch the model has not seen — its stroke amplitude chosen cycle
+    by cycle with the streaming PR-SSM. Returns the report (``cycles``: per cycle the stroke
+    scale, the measured and predicted lift, the error in %) as a dict."""
+    text = _native.design_control(
+        os.fspath(prssm), float(lift_n), float(density_factor), float(bias_fx_n), int(cycles),
+        frequency_hz, None if out is None else os.fspath(out), int(particles), int(seed),
+        progress,
     )
     return json.loads(text)
 

@@ -126,6 +126,7 @@ impl Family {
 }
 
 mod fourier;
+pub mod harmonic;
 pub mod measured;
 pub mod paper;
 mod spec;
@@ -133,7 +134,7 @@ pub mod stats;
 
 pub use fourier::FourierSeries;
 use fourier::smooth_square;
-pub use spec::TrajectorySpec;
+pub use spec::{TrajectorySpec, ramp};
 
 /// Sampling rates and lengths.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

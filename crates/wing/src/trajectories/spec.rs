@@ -68,7 +68,7 @@ impl TrajectorySpec {
 }
 
 /// C² ramp r(t) = 10s³ − 15s⁴ + 6s⁵ (s = t/T clamped to [0, 1]) and its derivatives.
-pub(super) fn ramp(t_s: f64, ramp_s: f64) -> (f64, f64, f64) {
+pub fn ramp(t_s: f64, ramp_s: f64) -> (f64, f64, f64) {
     if t_s >= ramp_s {
         return (1.0, 0.0, 0.0);
     }
