@@ -179,8 +179,8 @@ impl Objective {
     }
 
     fn forward(&mut self, theta: &[f64]) -> Result<Evaluation, DesignError> {
-        let names = HarmonicKinematics::parameter_names(self.problem.harmonics);
         if let Some(i) = theta.iter().position(|v| !v.is_finite()) {
+            let names = HarmonicKinematics::parameter_names(self.problem.harmonics);
             return Err(DesignError::invalid(
                 format!("kinematics.{}", names[i]),
                 "not finite",

@@ -176,3 +176,34 @@ fn the_closed_loop_holds_lift_on_a_denser_fluid() {
         "does not stay within 5 %"
     );
 }
+
+/// The rig's stand-in reads loads in the wing's units and frame: on 40 measured training
+/// trajectories its cycle-mean lift and thrust follow the plant's (the rig agrees with the
+/// default wing on the normal force, docs/rig-agreement.md).
+#[test]
+fn the_rig_stand_in_reads_the_wings_units() {
+    use flapssm_jobs::design::standin::RigStandIn;
+    use flapssm_jobs::rig::load_reference_model;
+    let (ctx, _) = fixture();
+    let npz = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../../shared/reference/bayiz2021-prssm/reference.npz");
+    let rig = RigStandIn::new(&load_reference_model(&npz).unwrap(), ctx, 10, 1).unwrap();
+    let grid = flapssm_design::DesignGrid::paper();
+    let (mut plant, mut standin) = (Vec::new(), Vec::new());
+    for c in &ctx.cases[..40] {
+        let w = grid.window(c.frequency_hz, ctx.ramp_cycles).unwrap();
+        plant.push(c.cycle_means(w.clone(), ctx.wing.sensor_radius_m));
+        standin.push(
+            rig.cycle_means(&c.states, w, ctx.wing.sensor_radius_m)
+                .unwrap(),
+        );
+    }
+    let r = |i: usize| {
+        let a: Vec<f64> = plant.iter().map(|q| q[i]).collect();
+        let b: Vec<f64> = standin.iter().map(|q| q[i]).collect();
+        flapssm_analysis::rig::pearson(&a, &b, "cycle means").unwrap()
+    };
+    let (lift, thrust) = (r(quantity::LIFT), r(quantity::THRUST));
+    println!("r lift {lift:.3}, thrust {thrust:.3}");
+    assert!(lift > 0.7 && thrust > 0.7, "r lift {lift}, thrust {thrust}");
+}

@@ -11,8 +11,10 @@ use flapssm_jobs::design::control::{CONTROL_FILES, ControlSettings, closed_loop,
 use flapssm_jobs::design::hover::{
     DESIGN_FILES, cycle_design, hover, median_frequency, write_cycle_design,
 };
-use flapssm_jobs::design::study::{STUDY_FILES, study, write_study};
+use flapssm_jobs::design::standin::RigStandIn;
+use flapssm_jobs::design::study::{STUDY_FILES, StudyModels, study, write_study};
 use flapssm_jobs::design::{DesignContext, DesignSettings, ModelChoice};
+use flapssm_jobs::rig::load_reference_model;
 use flapssm_jobs::{NoProgress, Progress};
 use flapssm_prssm::PrssmModel;
 use flapssm_qs::LrqsmModel;
@@ -134,6 +136,10 @@ struct StudyArgs {
     /// Cycle-mean designs only (no history designs).
     #[arg(long)]
     no_histories: bool,
+    /// The rig's stand-in (the published …/bayiz2021-prssm/reference.npz or a model imported
+    /// from it): every cycle-mean design judged on it too.
+    #[arg(long, value_name = "FILE")]
+    reference: Option<PathBuf>,
 }
 
 #[derive(Args)]
@@ -290,15 +296,20 @@ fn run_study(a: StudyArgs) -> anyhow::Result<()> {
     let bars = Bars::new();
     let l = load(&a.common, &STUDY_FILES, &bars)?;
     let p = progress_of(a.common.quiet, &bars);
-    let report = study(
-        &l.ctx,
-        &l.prssm,
-        l.lrqsm.as_ref(),
-        a.targets,
-        !a.no_histories,
-        &l.settings,
-        p,
-    )?;
+    let rig = a
+        .reference
+        .as_ref()
+        .map(|p| -> anyhow::Result<RigStandIn> {
+            let m = load_reference_model(p)?;
+            Ok(RigStandIn::new(&m, &l.ctx, 30, a.common.seed)?)
+        })
+        .transpose()?;
+    let models = StudyModels {
+        prssm: &l.prssm,
+        lrqsm: l.lrqsm.as_ref(),
+        rig: rig.as_ref(),
+    };
+    let report = study(&l.ctx, &models, a.targets, !a.no_histories, &l.settings, p)?;
     write_study(&report, &a.common.out)?;
     print_report(&report, &a.common.out, &STUDY_FILES, start);
     Ok(())

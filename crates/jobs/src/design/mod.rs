@@ -20,6 +20,7 @@
 
 pub mod control;
 pub mod hover;
+pub mod standin;
 pub mod study;
 
 use flapssm_design::{

@@ -11,6 +11,10 @@
 //! training trajectories. A history design targets the plant's wing-frame loads sample by
 //! sample over the window; its error is the RMS over samples and outputs in units of each
 //! output's SD. Model differences are paired by target, with 95 % Student-t intervals.
+//!
+//! With the rig's stand-in ([`super::standin`]), every cycle-mean design is judged a second
+//! time: its cycle means on the stand-in against the stand-in's own on the held-out trajectory
+//! (a target the rig achieved), in the same units.
 
 use std::path::Path;
 use std::time::Instant;
@@ -23,6 +27,7 @@ use flapssm_wing::stroke_loads::{QUANTITY_NAMES, quantity};
 use flapssm_wing::trajectories::paper::PAPER_N_TRAIN;
 use serde::{Deserialize, Serialize};
 
+use super::standin::RigStandIn;
 use super::{
     DesignContext, DesignSettings, ModelChoice, PLANT_STREAM, design_error, design_with, verify,
 };
@@ -61,6 +66,10 @@ pub struct ModelResult {
     pub history_error: Option<f64>,
     /// Share of the history design's plant samples inside its predicted 95 % band (PR-SSM).
     pub history_band_share: Option<f64>,
+    /// The cycle-mean design's cycle means on the rig's stand-in (7).
+    pub rig_achieved: Option<[f64; 7]>,
+    /// Their error against the stand-in's target (module docs).
+    pub rig_cycle_error: Option<f64>,
     /// The designs' limit excess, if any.
     pub limit_excess: Option<String>,
     /// Wall time of both designs (s).
@@ -78,6 +87,10 @@ pub struct TargetResult {
     pub target: [f64; 7],
     /// The error of the trajectory's own harmonic fit on the plant (cycle means; history).
     pub fit_floor: [f64; 2],
+    /// The rig stand-in's cycle means on the measured trajectory (7).
+    pub rig_target: Option<[f64; 7]>,
+    /// The error of the trajectory's own fit on the stand-in.
+    pub rig_fit_floor: Option<f64>,
     /// Per model.
     pub models: Vec<ModelResult>,
 }
@@ -146,17 +159,27 @@ fn history_error(achieved: &[[f64; 5]], target: &[[f64; 5]], scales: &[f64; 5]) 
     (s / (5 * achieved.len()).max(1) as f64).sqrt()
 }
 
-/// Runs the study on the first `n_targets` of the 36 held-out trajectories with the PR-SSM
-/// `prssm`, the LRQSM `lrqsm` (when given) and the quasi-steady wing; with `histories`, also
-/// a history design per model and target. `progress.advance(1)` per target.
+/// The models of a study and its second judge.
+pub struct StudyModels<'a> {
+    /// The PR-SSM.
+    pub prssm: &'a PrssmModel,
+    /// The LRQSM, when given.
+    pub lrqsm: Option<&'a LrqsmModel>,
+    /// The rig's stand-in, when given.
+    pub rig: Option<&'a RigStandIn>,
+}
+
+/// Runs the study on the first `n_targets` of the 36 held-out trajectories with the PR-SSM,
+/// the LRQSM (when given) and the quasi-steady wing; with `histories`, also a history design
+/// per model and target; with the rig's stand-in, every cycle-mean design judged on it too.
+/// `progress.advance(1)` per target.
 ///
 /// # Errors
 /// [`JobError::Setting`] for `n_targets` outside 2..=36 and bad settings; design and plant
 /// errors.
 pub fn study(
     ctx: &DesignContext,
-    prssm: &PrssmModel,
-    lrqsm: Option<&LrqsmModel>,
+    models: &StudyModels<'_>,
     n_targets: usize,
     histories: bool,
     settings: &DesignSettings,
@@ -172,11 +195,12 @@ pub fn study(
         });
     }
     let start = Instant::now();
-    let mut models = vec![ModelChoice::Prssm(prssm)];
-    if let Some(l) = lrqsm {
-        models.push(ModelChoice::Lrqsm(l));
+    let rig = models.rig;
+    let mut choices = vec![ModelChoice::Prssm(models.prssm)];
+    if let Some(l) = models.lrqsm {
+        choices.push(ModelChoice::Lrqsm(l));
     }
-    models.push(ModelChoice::QuasiSteady);
+    choices.push(ModelChoice::QuasiSteady);
     let grid = DesignGrid::paper();
     let r_s = ctx.wing.sensor_radius_m;
     progress.start("designs for held-out targets", n_targets as u64);
@@ -196,9 +220,24 @@ pub fn study(
             cycle_error(&floor.cycle_means, &target, &ctx.quantity_scales),
             history_error(&floor.outputs, &history, &ctx.output_scales),
         ];
+        let grid_states = |k: &flapssm_wing::trajectories::harmonic::HarmonicKinematics| {
+            let mut st = vec![flapssm_wing::kinematics::EulerState::default(); grid.n_samples];
+            k.sample_into(grid.dt_s, &mut st);
+            st
+        };
+        let rig_target = rig
+            .map(|r| r.cycle_means(&case.states, window.clone(), r_s))
+            .transpose()?;
+        let rig_fit_floor = match (rig, &rig_target) {
+            (Some(r), Some(t)) => {
+                let got = r.cycle_means(&grid_states(&case.fit), window.clone(), r_s)?;
+                Some(cycle_error(&got, t, &ctx.quantity_scales))
+            }
+            _ => None,
+        };
         let starts = ctx.starts(&values, settings.starts, None);
         let mut results = Vec::new();
-        for m in &models {
+        for m in &choices {
             let t0 = Instant::now();
             let cm = Target::CycleMeans { values };
             let p = ctx.problem(cm, f, settings, 0.0);
@@ -221,9 +260,16 @@ pub fn study(
                 inside_band,
                 history_error: None,
                 history_band_share: None,
+                rig_achieved: None,
+                rig_cycle_error: None,
                 limit_excess: d.limit_excess.clone(),
                 wall_s: 0.0,
             };
+            if let (Some(rig), Some(t)) = (rig, &rig_target) {
+                let got = rig.cycle_means(&grid_states(&d.kinematics), window.clone(), r_s)?;
+                r.rig_cycle_error = Some(cycle_error(&got, t, &ctx.quantity_scales));
+                r.rig_achieved = Some(got);
+            }
             if histories {
                 let ht = Target::History {
                     outputs: history.clone(),
@@ -259,6 +305,8 @@ pub fn study(
             frequency_hz: f,
             target,
             fit_floor,
+            rig_target,
+            rig_fit_floor,
             models: results,
         });
         progress.advance(1);
@@ -309,6 +357,25 @@ fn summarize(
         let base = col(0, hist);
         for (j, n) in names.iter().enumerate().skip(1) {
             let d: Vec<f64> = base.iter().zip(col(j, hist)).map(|(a, b)| a - b).collect();
+            paired.extend(interval(format!("{} − {n}, {kind}", names[0]), &d));
+        }
+    }
+    let rig_col = |j: usize| -> Vec<f64> {
+        targets
+            .iter()
+            .filter_map(|t| t.models[j].rig_cycle_error)
+            .collect()
+    };
+    if !rig_col(0).is_empty() {
+        let kind = "cycle means on the rig stand-in";
+        let floor: Vec<f64> = targets.iter().filter_map(|t| t.rig_fit_floor).collect();
+        errors.extend(interval(format!("fit floor, {kind}"), &floor));
+        for (j, n) in names.iter().enumerate() {
+            errors.extend(interval(format!("{n}, {kind}"), &rig_col(j)));
+        }
+        let base = rig_col(0);
+        for (j, n) in names.iter().enumerate().skip(1) {
+            let d: Vec<f64> = base.iter().zip(rig_col(j)).map(|(a, b)| a - b).collect();
             paired.extend(interval(format!("{} − {n}, {kind}", names[0]), &d));
         }
     }
