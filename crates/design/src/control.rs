@@ -14,7 +14,7 @@
 
 use flapssm_prssm::stream::StreamPredictor;
 use flapssm_wing::kinematics::{EulerState, WingKinematics};
-use flapssm_wing::stroke_loads::{quantity, stroke_frame_loads};
+use flapssm_wing::stroke_loads::{mean_stroke_frame_loads, quantity, stroke_frame_loads};
 use flapssm_wing::trajectories::harmonic::HarmonicKinematics;
 use flapssm_wing::trajectories::ramp;
 
@@ -79,13 +79,7 @@ pub fn cycle_samples(frequency_hz: f64, dt_s: f64, k: usize) -> std::ops::Range<
 
 /// Mean lift (N) of predicted or measured wing-frame loads over `states`.
 pub fn mean_lift(loads: &[[f64; 5]], states: &[EulerState], sensor_radius_m: f64) -> f64 {
-    let n = loads.len().max(1) as f64;
-    loads
-        .iter()
-        .zip(states)
-        .map(|(y, s)| stroke_frame_loads(y, s, sensor_radius_m)[quantity::LIFT])
-        .sum::<f64>()
-        / n
+    mean_stroke_frame_loads(loads, states, sensor_radius_m)[quantity::LIFT]
 }
 
 /// Advances `predictor` over `states` (one sample each), returning the predicted mean lift.

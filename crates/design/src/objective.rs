@@ -4,7 +4,7 @@ use std::ops::Range;
 
 use flapssm_wing::input_jacobian::input_jacobian;
 use flapssm_wing::kinematics::{EulerState, WingKinematics};
-use flapssm_wing::stroke_loads::{quantity, stroke_frame_jacobian, stroke_frame_loads};
+use flapssm_wing::stroke_loads::{mean_stroke_frame_loads, quantity, stroke_frame_jacobian};
 use flapssm_wing::trajectories::harmonic::HarmonicKinematics;
 
 use crate::error::DesignError;
@@ -39,7 +39,7 @@ pub struct Objective {
     kinematics: HarmonicKinematics,
     states: Vec<EulerState>,
     inputs: Vec<f64>,
-    mean: Vec<f64>,
+    mean: Vec<[f64; 5]>,
     var: Vec<f64>,
     mean_bar: Vec<f64>,
     var_bar: Vec<f64>,
@@ -66,7 +66,7 @@ impl Objective {
             ),
             states: vec![EulerState::default(); n],
             inputs: vec![0.0; n * N_INPUT],
-            mean: vec![0.0; n * N_OUTPUT],
+            mean: vec![[0.0; N_OUTPUT]; n],
             var: vec![0.0; n * N_OUTPUT],
             mean_bar: vec![0.0; n * N_OUTPUT],
             var_bar: vec![0.0; n * N_OUTPUT],
@@ -126,7 +126,7 @@ impl Objective {
 
     /// The predicted wing-frame means and variances of the last evaluation (`T × 5`).
     pub fn prediction(&self) -> (&[f64], &[f64]) {
-        (&self.mean, &self.var)
+        (self.mean.as_flattened(), &self.var)
     }
 
     /// The number of parameters.
@@ -163,7 +163,7 @@ impl Objective {
             ));
         }
         let ev = self.forward(theta)?;
-        if self.backward(grad)? {
+        if self.backward(&ev.cycle_means, grad)? {
             return Ok(ev);
         }
         let mut probe = theta.to_vec();
@@ -200,17 +200,20 @@ impl Objective {
             &self.states,
             &self.inputs,
             dt,
-            &mut self.mean,
+            self.mean.as_flattened_mut(),
             &mut self.var,
         )?;
         let p = &self.problem;
-        let n_w = self.window.len() as f64;
-        let mut q_bar = [0.0; 7];
+        let w = self.window.clone();
+        let n_w = w.len() as f64;
+        let q_bar = mean_stroke_frame_loads(
+            &self.mean[w.clone()],
+            &self.states[w.clone()],
+            p.sensor_radius_m,
+        );
         let (mut fit, mut robust) = (0.0, 0.0);
-        for (j, t) in self.window.clone().enumerate() {
-            let y: [f64; 5] = self.mean[t * 5..(t + 1) * 5].try_into().expect("5");
-            let q = stroke_frame_loads(&y, &self.states[t], p.sensor_radius_m);
-            q_bar.iter_mut().zip(q).for_each(|(a, b)| *a += b / n_w);
+        for (j, t) in w.enumerate() {
+            let y = self.mean[t];
             for k in 0..N_OUTPUT {
                 let s2 = p.output_scales[k] * p.output_scales[k];
                 robust += p.robust_weight * self.var[t * 5 + k] / (s2 * n_w);
@@ -247,19 +250,13 @@ impl Objective {
         })
     }
 
-    /// The exact gradient of the last [`Self::forward`] into `grad`; `Ok(false)` when the
-    /// model has no input gradient.
-    fn backward(&mut self, grad: &mut [f64]) -> Result<bool, DesignError> {
+    /// The exact gradient of the last [`Self::forward`] (its cycle means `q_bar`) into `grad`;
+    /// `Ok(false)` when the model has no input gradient.
+    fn backward(&mut self, q_bar: &[f64; 7], grad: &mut [f64]) -> Result<bool, DesignError> {
         let p = &self.problem;
         let n_w = self.window.len() as f64;
         // ∂J/∂q̄ of the cycle-mean terms.
         let mut g_q = [0.0; 7];
-        let mut q_bar = [0.0; 7];
-        for t in self.window.clone() {
-            let y: [f64; 5] = self.mean[t * 5..(t + 1) * 5].try_into().expect("5");
-            let q = stroke_frame_loads(&y, &self.states[t], p.sensor_radius_m);
-            q_bar.iter_mut().zip(q).for_each(|(a, b)| *a += b / n_w);
-        }
         if let Target::CycleMeans { values } = &p.target {
             for (i, v) in values.iter().enumerate() {
                 if let Some(v) = v {
@@ -272,7 +269,7 @@ impl Objective {
         self.var_bar.fill(0.0);
         self.s_bar.iter_mut().for_each(|s| *s = [0.0; 9]);
         for (j, t) in self.window.clone().enumerate() {
-            let y: [f64; 5] = self.mean[t * 5..(t + 1) * 5].try_into().expect("5");
+            let y = self.mean[t];
             let (dy, ds) = stroke_frame_jacobian(&y, &self.states[t], p.sensor_radius_m);
             for ((g, dy_i), ds_i) in g_q.iter().zip(&dy).zip(&ds) {
                 if *g == 0.0 {
@@ -341,7 +338,7 @@ impl Objective {
         let mut per_particle = vec![[0.0; 7]; n_p];
         let mut obs_var = [0.0; 7];
         for t in self.window.clone() {
-            let m: [f64; 5] = self.mean[t * 5..(t + 1) * 5].try_into().expect("5");
+            let m = self.mean[t];
             let (dy, _) = stroke_frame_jacobian(&m, &self.states[t], p.sensor_radius_m);
             for (pp, q) in per_particle.iter_mut().enumerate() {
                 let yp = &y[(t * n_p + pp) * 5..(t * n_p + pp + 1) * 5];

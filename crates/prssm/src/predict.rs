@@ -304,6 +304,22 @@ pub fn predict_particles(
     Ok((p, all))
 }
 
+/// The initial particles `x` (`P × D_x`) `m₀ + s₀ ⊙ ε₀`, the draws particle by particle, dim by
+/// dim, from `rng`: the first draws of every prediction from a seed.
+pub(crate) fn draw_initial<T: StepFloat>(
+    rng: &mut ChaCha8Rng,
+    init_mean: &[f64],
+    init_std: &[f64],
+    x: &mut [T],
+) {
+    for c in x.chunks_exact_mut(init_mean.len().max(1)) {
+        for ((x, m), s) in c.iter_mut().zip(init_mean).zip(init_std) {
+            let e: f64 = StandardNormal.sample(&mut *rng);
+            *x = T::of(m + s * e);
+        }
+    }
+}
+
 /// The prediction loop of [`predict`] in `T` with `(particles, seed)`, copying the particles
 /// of every step into `keep` (`T × P × D_x`) when given.
 fn run_prediction<T: StepFloat>(
@@ -330,12 +346,7 @@ fn run_prediction<T: StepFloat>(
     let mut sp = ParticleStep::<T>::new(config, params, particles)?;
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let mut x = vec![T::of(0.0); particles * dx];
-    for c in x.chunks_exact_mut(dx) {
-        for d in 0..dx {
-            let e: f64 = StandardNormal.sample(&mut rng);
-            c[d] = T::of(init_mean[d] + init_std[d] * e);
-        }
-    }
+    draw_initial(&mut rng, init_mean, init_std, &mut x);
     let (vx, vy) = (&params.process_noise_var, &params.obs_noise_var);
     let mut pred = empty_prediction(t_n, dx, dy);
     let mut record = |t: usize, x: &[T]| {

@@ -22,13 +22,12 @@
 
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use rand_distr::{Distribution, StandardNormal};
 
 use crate::conditional::{ConditionalGrads, ConditionalWorkspace, Posterior};
 use crate::model::{Normalization, PrssmModel};
 use crate::objective::ObjectiveError;
 use crate::params::{ModelConfig, Params};
-use crate::predict::{Prediction, empty_prediction, moments, prediction_posterior};
+use crate::predict::{Prediction, draw_initial, empty_prediction, moments, prediction_posterior};
 use crate::step::StepDraws;
 
 /// A predictor that also differentiates its prediction with respect to the inputs. Buffers
@@ -177,12 +176,7 @@ impl InputSensitivity {
         let xs = sized(&mut self.xs, t_n * step);
         let eps = sized(&mut self.eps, (t_n - 1) * step);
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
-        for c in xs[..step].chunks_exact_mut(dx) {
-            for d in 0..dx {
-                let e: f64 = StandardNormal.sample(&mut rng);
-                c[d] = init_mean[d] + init_std[d] * e;
-            }
-        }
+        draw_initial(&mut rng, init_mean, init_std, &mut xs[..step]);
         let draws = StepDraws {
             dx,
             shared: self.config.shared_draws,

@@ -79,6 +79,22 @@ pub fn stroke_frame_loads(y: &[f64; 5], state: &EulerState, sensor_radius_m: f64
     [f[0], f[1], f[2], m[0], m[1], m[2], p]
 }
 
+/// The means over the samples of the 7 quantities of [`stroke_frame_loads`] of wing-frame
+/// `loads` at `states` (one state per row; the cycle means when the rows span whole cycles).
+pub fn mean_stroke_frame_loads(
+    loads: &[[f64; 5]],
+    states: &[EulerState],
+    sensor_radius_m: f64,
+) -> [f64; 7] {
+    let n = loads.len().max(1) as f64;
+    let mut q = [0.0; 7];
+    for (y, s) in loads.iter().zip(states) {
+        let v = stroke_frame_loads(y, s, sensor_radius_m);
+        q.iter_mut().zip(v).for_each(|(a, b)| *a += b / n);
+    }
+    q
+}
+
 /// `∂q/∂y` (7 × 5) and `∂q/∂s` (7 × 9, the state vector of [`crate::input_jacobian`]) of the
 /// quantities `q` of [`stroke_frame_loads`].
 pub fn stroke_frame_jacobian(

@@ -32,7 +32,7 @@ use flapssm_qs::LrqsmModel;
 use flapssm_wing::cycles::stroke_reversals;
 use flapssm_wing::kinematics::EulerState;
 use flapssm_wing::sensor::DatasetSensorErrors;
-use flapssm_wing::stroke_loads::stroke_frame_loads;
+use flapssm_wing::stroke_loads::mean_stroke_frame_loads;
 use flapssm_wing::trajectories::SamplingConfig;
 use flapssm_wing::trajectories::harmonic::{HarmonicKinematics, KinematicLimits};
 use flapssm_wing::trajectories::measured::raw_states;
@@ -163,13 +163,7 @@ pub fn cycle_means(
     window: std::ops::Range<usize>,
     sensor_radius_m: f64,
 ) -> [f64; 7] {
-    let n = window.len() as f64;
-    let mut q = [0.0; 7];
-    for t in window {
-        let v = stroke_frame_loads(&outputs[t], &states[t], sensor_radius_m);
-        q.iter_mut().zip(v).for_each(|(a, b)| *a += b / n);
-    }
-    q
+    mean_stroke_frame_loads(&outputs[window.clone()], &states[window], sensor_radius_m)
 }
 
 /// What a design on the measured set needs (module docs).
